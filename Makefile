@@ -1,0 +1,79 @@
+# PoroMPM - one boring Makefile.
+#   make run     install what is missing, build, run the Terzaghi example and report its error
+#   make test    unit tests, reduced-size verification, bad-input tests; ends "N passed, N failed"
+#   make verify  paper-size verification runs (long)
+#   make bench   speed figures (printed, never asserted)
+#   make test SAN=1   the same tests under AddressSanitizer + UBSan
+# Every public target first runs deploy/deps.sh, which returns at once when nothing is missing.
+
+CC      ?= cc
+BUILD   ?= build$(if $(SAN),-san)
+OPT     ?= -O2
+WARN    = -Wall -Wextra -Wshadow -Wno-unused-parameter $(if $(CI),-Werror)
+SANITIZERS = -fsanitize=address,undefined -fno-omit-frame-pointer
+SANFLAGS = $(if $(SAN),$(SANITIZERS))
+PKGS    = jansson hdf5
+CPPFLAGS = -D_POSIX_C_SOURCE=200809L -DPORO_VERSION=\"$(VERSION)\" -Isolver -I/usr/include/suitesparse $(shell pkg-config --cflags $(PKGS) 2>/dev/null)
+VERSION := $(shell git describe --always --dirty --tags 2>/dev/null || echo unknown)
+CFLAGS  = -std=c11 $(OPT) -g -fopenmp $(WARN) $(SANFLAGS)
+LDLIBS  = $(shell pkg-config --libs $(PKGS) 2>/dev/null) -lcholmod -lm
+LDFLAGS = -fopenmp $(SANFLAGS)
+
+SOLVER_SRC = $(wildcard solver/*.c)
+SOLVER_OBJ = $(SOLVER_SRC:%.c=$(BUILD)/%.o)
+LIBPORO    = $(BUILD)/libporo.a
+POROSOLVE  = $(BUILD)/poro-solve
+TEST_SRC   = $(wildcard tests/solver/*_test.c tests/verify/*_test.c)
+TEST_BIN   = $(TEST_SRC:%.c=$(BUILD)/%)
+BENCH_SRC  = $(wildcard bench/*_bench.c)
+BENCH_BIN  = $(BENCH_SRC:%.c=$(BUILD)/%)
+
+.PHONY: all deps run test verify bench clean build-all format
+.DEFAULT_GOAL := all
+
+deps:
+	@bash deploy/deps.sh
+
+all: deps
+	@$(MAKE) --no-print-directory build-all
+
+build-all: $(POROSOLVE) $(TEST_BIN) $(BENCH_BIN)
+
+run: deps
+	@$(MAKE) --no-print-directory build-all
+	@bash tests/run_example.sh $(BUILD)
+
+test: deps
+	@$(MAKE) --no-print-directory build-all
+	@bash tests/run.sh $(BUILD) test
+
+verify: deps
+	@$(MAKE) --no-print-directory build-all
+	@bash tests/run.sh $(BUILD) verify
+
+bench: deps
+	@$(MAKE) --no-print-directory build-all
+	@bash bench/run.sh $(BUILD)
+
+$(BUILD)/%.o: %.c $(wildcard solver/*.h tests/*.h)
+	@mkdir -p $(dir $@)
+	$(CC) $(CPPFLAGS) $(CFLAGS) -c $< -o $@
+
+$(LIBPORO): $(SOLVER_OBJ)
+	@rm -f $@
+	ar rcs $@ $^
+
+$(POROSOLVE): $(BUILD)/cli/poro_solve.o $(LIBPORO)
+	$(CC) $(LDFLAGS) $^ $(LDLIBS) -o $@
+
+$(BUILD)/tests/%: $(BUILD)/tests/%.o $(LIBPORO)
+	$(CC) $(LDFLAGS) $^ $(LDLIBS) -o $@
+
+$(BUILD)/bench/%: $(BUILD)/bench/%.o $(LIBPORO)
+	$(CC) $(LDFLAGS) $^ $(LDLIBS) -o $@
+
+format:
+	clang-format -i solver/*.c solver/*.h cli/*.c tests/*/*.c bench/*.c
+
+clean:
+	rm -rf build build-san

@@ -1,0 +1,153 @@
+/*
+ * case.h - the case spec as C data: what schemas/case.schema.json describes, loaded from JSON.
+ *
+ * A case says everything needed to rerun an example and nothing about the machine. Field names are
+ * the JSON keys (STYLE rule 9); units are SI and given with each field. Loading validates fully:
+ * every problem is reported as one line "JSON-pointer: message" in the error record, and no
+ * partially filled case is ever returned to the caller.
+ *
+ * Ownership: case_load_file()/case_load_string() return a heap object the caller frees with
+ * case_destroy(&c). The original JSON text is kept in c->json (written to result files as /case).
+ */
+#ifndef PORO_CASE_H
+#define PORO_CASE_H
+
+#include "error.h"
+
+#define CASE_NAME_MAX 64
+#define CASE_SCHEMA_VERSION "poro-case/1"
+
+enum case_scheme { SCHEME_SEMI_IMPLICIT };
+enum case_phases { PHASES_DOUBLE_POINT, PHASES_SINGLE_POINT };
+enum case_shape { SHAPE_LINEAR, SHAPE_QUADRATIC_BSPLINE };
+
+enum material_model { MODEL_LINEAR_ELASTIC, MODEL_HENCKY };
+
+enum permeability_law { PERMEABILITY_CONSTANT, PERMEABILITY_KOZENY_CARMAN };
+
+/* Velocity constraint of one phase on a grid face: free, slip (normal component zero: a roller),
+ * fixed (both components zero). */
+enum face_constraint { CONSTRAINT_FREE, CONSTRAINT_SLIP, CONSTRAINT_FIXED };
+/* Drainage of a grid face, independent of its velocity constraint: impermeable (no flux: the
+ * natural condition of the pressure equation) or drained (pore pressure zero on the face). */
+enum face_drainage { DRAINAGE_IMPERMEABLE, DRAINAGE_DRAINED };
+enum grid_face { FACE_LEFT, FACE_RIGHT, FACE_BOTTOM, FACE_TOP, FACE_COUNT };
+
+enum time_function_kind { TIME_CONSTANT, TIME_RAMP, TIME_SINUSOID };
+
+enum probe_kind { PROBE_PORE_PRESSURE, PROBE_DISPLACEMENT, PROBE_AVERAGE };
+enum probe_field { FIELD_PORE_PRESSURE, FIELD_STRESS_XX, FIELD_STRESS_YY, FIELD_STRESS_XY,
+		   FIELD_DISPLACEMENT_X, FIELD_DISPLACEMENT_Y };
+
+struct case_formulation {
+	enum case_scheme scheme;          /* "semi_implicit" */
+	enum case_phases phases;          /* "double_point" (default) or "single_point" */
+	enum case_shape shape;            /* "linear" or "quadratic_bspline" (default) */
+	int pore_pressure_smoothing;      /* node-wise smoothing, 000 Eq. 77; default true */
+	double flip_fraction;             /* 1 = pure FLIP (default), 0 = PIC; velocity update blend */
+};
+
+struct case_grid {
+	double origin[2];                 /* lower-left corner, m */
+	double extent[2];                 /* width and height, m; multiples of cell_size */
+	double cell_size;                 /* h, m (square cells) */
+};
+
+struct case_material {
+	char name[CASE_NAME_MAX];
+	enum material_model model;        /* "linear_elastic" (small strain) or "hencky" (finite strain) */
+	double density;                   /* soil grain density rho_s, kg/m^3 */
+	double youngs_modulus;            /* E, Pa, > 0 */
+	double poisson_ratio;             /* nu, -1 < nu < 0.5 */
+};
+
+#define CASE_POLYGON_MAX 64
+struct case_body {
+	char name[CASE_NAME_MAX];
+	int material;                     /* index into case.materials */
+	int is_polygon;                   /* 0: rectangle [min, max]; 1: polygon */
+	double min[2], max[2];            /* rectangle corners, m (for a polygon: its bounding box) */
+	int polygon_count;
+	double polygon[CASE_POLYGON_MAX][2]; /* vertices, m, counter-clockwise or clockwise */
+	int particles_per_cell;           /* points per cell per direction (2 means 2x2) */
+	double porosity;                  /* initial porosity n0, 0 < n0 < 1 */
+	double hydraulic_conductivity;    /* k0, m/s, > 0 */
+	enum permeability_law permeability_law; /* "constant" (default) or "kozeny_carman" (000 step 8g) */
+};
+
+struct case_time_function {
+	enum time_function_kind kind;     /* "constant" | "ramp" | "sinusoid" */
+	double ramp_time;                 /* ramp: s, value rises linearly from 0 to 1 over [0, ramp_time] */
+	double frequency;                 /* sinusoid: Hz */
+	double amplitude;                 /* sinusoid: dimensionless; value = mean + amplitude sin(2 pi f t + phase) */
+	double mean;                      /* sinusoid: dimensionless, default 0 */
+	double phase;                     /* sinusoid: rad */
+};
+
+struct case_boundary {
+	enum face_constraint soil;        /* soil velocity constraint on the face */
+	enum face_constraint water;       /* water velocity constraint on the face */
+	enum face_drainage drainage;
+};
+
+struct case_load {
+	int body;                         /* index into case.bodies */
+	enum grid_face face;              /* which face of the body's bounding box: left/right/bottom/top */
+	double from, to;                  /* extent along the face, m (x for top/bottom, y for left/right);
+					     default the whole face */
+	double traction[2];               /* Pa, applied to the soil skeleton (000 Eq. 54) */
+	struct case_time_function time_function;
+};
+
+struct case_probe {
+	char name[CASE_NAME_MAX];
+	enum probe_kind kind;             /* "pore_pressure" at point, "displacement" of the soil point
+					     nearest to point, "average" of field over box */
+	double point[2];                  /* m */
+	int component;                    /* displacement: 0 = x, 1 = y */
+	enum probe_field field;           /* average: which field */
+	double box_min[2], box_max[2];    /* average: box, m */
+};
+
+struct case_spec {
+	char title[256];
+	struct case_formulation formulation;
+	struct case_grid grid;
+	int material_count;
+	struct case_material *materials;
+	int body_count;
+	struct case_body *bodies;
+	struct {
+		double density;           /* rho_w, kg/m^3 */
+		double bulk_modulus;      /* K_w, Pa (unused by the semi-implicit scheme; for the explicit one) */
+	} fluid;
+	struct {
+		double acceleration[2];   /* body force b, m/s^2, e.g. [0, -9.81] */
+		double ramp_time;         /* s; 0 = applied at once */
+	} gravity;
+	struct case_boundary boundaries[FACE_COUNT];
+	int load_count;
+	struct case_load *loads;
+	struct {
+		double dt;                /* time step, s, > 0 */
+		double end;               /* end time, s, > 0 */
+	} time;
+	struct {
+		double frame_interval;    /* s; 0 = first and last frame only */
+		double progress_interval; /* s of wall time between progress lines, default 1 */
+	} output;
+	int probe_count;
+	struct case_probe *probes;
+	char *json;                       /* the case as given, NUL-terminated */
+};
+
+/* Loads and validates a case. On failure returns PORO_EINVAL (or PORO_EIO for an unreadable file)
+ * with every problem listed in err->message, one "JSON-pointer: message" per line, and *out NULL. */
+enum poro_status case_load_file(const char *path, struct case_spec **out, struct poro_error *err);
+enum poro_status case_load_string(const char *json, struct case_spec **out, struct poro_error *err);
+void case_destroy(struct case_spec **c);
+
+/* Value of a time function at time t (dimensionless factor). */
+double case_time_function_value(const struct case_time_function *f, double t);
+
+#endif

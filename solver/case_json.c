@@ -1,0 +1,395 @@
+/*
+ * case_json.c - typed, pointer-tracking reads of a JSON document for the case loader (case_json.h).
+ *
+ * The only file of the case loader that talks to jansson. Parsing rejects duplicate object keys
+ * (jansson would otherwise keep the last silently) and NUL characters inside strings. jansson
+ * itself refuses NaN, Infinity and numbers that overflow a double, so every number read here is
+ * finite; the check is kept anyway because the document is outside input (STYLE rule 12).
+ *
+ * A JSON "integer" is any number with no fractional part (2 and 2.0 alike), as in JSON Schema.
+ * Strings from the document that appear in messages are cut short and control characters are
+ * replaced by '?' (case_quote), so that every problem stays one line.
+ */
+#include "case_json.h"
+
+#include <jansson.h>
+#include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <string.h>
+
+#define PROBLEM_MAX 1024            /* longest single problem message */
+
+void case_problem(struct case_reader *r, const char *pointer, const char *fmt, ...)
+{
+	char message[PROBLEM_MAX];
+	va_list ap;
+	va_start(ap, fmt);
+	vsnprintf(message, sizeof message, fmt, ap);
+	va_end(ap);
+	/* The empty pointer is the whole document; show it as "/" so every line starts alike. */
+	const char *where = pointer[0] ? pointer : "/";
+	if (r->problem_count++ == 0)
+		poro_error_set(r->err, PORO_EINVAL, "%s: %s", where, message);
+	else
+		poro_error_append(r->err, "%s: %s", where, message);
+}
+
+const char *case_quote(char *dst, const char *s)
+{
+	size_t n = 0, limit = CASE_QUOTE_SIZE - sizeof "...";
+	for (; n < limit && s[n]; n++)
+		dst[n] = (unsigned char)s[n] < 0x20 || s[n] == 0x7f ? '?' : s[n];
+	if (s[n]) {
+		while (n > 0 && ((unsigned char)s[n] & 0xc0) == 0x80)
+			n--;                        /* do not cut a UTF-8 character in two */
+		strcpy(dst + n, "...");
+	} else {
+		dst[n] = '\0';
+	}
+	return dst;
+}
+
+void case_pointer_key(char *dst, const char *base, const char *key)
+{
+	size_t n = (size_t)snprintf(dst, CASE_POINTER_MAX, "%s/", base);
+	for (const char *k = key; *k && n + 3 < CASE_POINTER_MAX; k++) {
+		if (*k == '~' || *k == '/') {       /* RFC 6901: '~' is written ~0, '/' is ~1 */
+			dst[n++] = '~';
+			dst[n++] = *k == '~' ? '0' : '1';
+		} else {
+			dst[n++] = (unsigned char)*k < 0x20 || *k == 0x7f ? '?' : *k;
+		}
+	}
+	if (n >= CASE_POINTER_MAX)
+		n = CASE_POINTER_MAX - 1;
+	dst[n] = '\0';
+}
+
+void case_pointer_index(char *dst, const char *base, size_t index)
+{
+	snprintf(dst, CASE_POINTER_MAX, "%s/%zu", base, index);
+}
+
+const char *case_format_number(char *dst, double x)
+{
+	for (int precision = 6; precision <= 17; precision++) {
+		snprintf(dst, CASE_NUMBER_SIZE, "%.*g", precision, x);
+		if (strtod(dst, NULL) == x)
+			break;
+	}
+	return dst;
+}
+
+static const char *type_name(const json_t *v)
+{
+	switch (json_typeof(v)) {
+	case JSON_OBJECT: return "object";
+	case JSON_ARRAY: return "array";
+	case JSON_STRING: return "string";
+	case JSON_INTEGER:
+	case JSON_REAL: return "number";
+	case JSON_TRUE:
+	case JSON_FALSE: return "boolean";
+	case JSON_NULL: return "null";
+	}
+	return "unknown";
+}
+
+json_t *case_json_parse(struct case_reader *r, const char *text)
+{
+	json_error_t e;
+	json_t *doc = json_loads(text, JSON_REJECT_DUPLICATES, &e);
+	if (!doc) {
+		case_problem(r, "", "malformed JSON at line %d column %d: %s", e.line, e.column, e.text);
+		return NULL;
+	}
+	if (!json_is_object(doc)) {
+		case_problem(r, "", "expected an object, got %s", type_name(doc));
+		json_decref(doc);
+		return NULL;
+	}
+	return doc;
+}
+
+void case_json_free(json_t *doc)
+{
+	json_decref(doc);
+}
+
+static int is_allowed(const char *key, const char *const *allowed)
+{
+	for (; *allowed; allowed++)
+		if (strcmp(key, *allowed) == 0)
+			return 1;
+	return 0;
+}
+
+void case_check_keys(struct case_reader *r, const json_t *obj, const char *base,
+		     const char *const *allowed)
+{
+	const char *key;
+	json_t *value;
+	char pointer[CASE_POINTER_MAX];
+	/* jansson's iteration macros take a non-const object; nothing is modified. */
+	json_object_foreach((json_t *)obj, key, value) {
+		if (!is_allowed(key, allowed)) {
+			case_pointer_key(pointer, base, key);
+			case_problem(r, pointer, "unknown key");
+		}
+	}
+}
+
+int case_has_key(const json_t *obj, const char *key)
+{
+	return json_object_get(obj, key) != NULL;
+}
+
+static int below_ok(double x, const struct case_range *range)
+{
+	switch (range->lo_kind) {
+	case BOUND_OPEN: return x > range->lo;
+	case BOUND_CLOSED: return x >= range->lo;
+	case BOUND_NONE: break;
+	}
+	return 1;
+}
+
+static int above_ok(double x, const struct case_range *range)
+{
+	switch (range->hi_kind) {
+	case BOUND_OPEN: return x < range->hi;
+	case BOUND_CLOSED: return x <= range->hi;
+	case BOUND_NONE: break;
+	}
+	return 1;
+}
+
+int case_check_range(struct case_reader *r, const char *pointer, double x, const struct case_range *range)
+{
+	if (below_ok(x, range) && above_ok(x, range))
+		return 1;
+	char lo[CASE_NUMBER_SIZE], hi[CASE_NUMBER_SIZE], got[CASE_NUMBER_SIZE], want[128] = "";
+	size_t n = 0;
+	if (range->lo_kind != BOUND_NONE)
+		n += (size_t)snprintf(want, sizeof want, "%s %s", range->lo_kind == BOUND_OPEN ? ">" : ">=",
+				      case_format_number(lo, range->lo));
+	if (range->hi_kind != BOUND_NONE)
+		snprintf(want + n, sizeof want - n, "%s%s %s", n ? " and " : "",
+			 range->hi_kind == BOUND_OPEN ? "<" : "<=", case_format_number(hi, range->hi));
+	case_problem(r, pointer, "must be %s, got %s", want, case_format_number(got, x));
+	return 0;
+}
+
+/* Looks up obj[key], writing its pointer; records a problem if it is required and absent. */
+static const json_t *member(struct case_reader *r, const json_t *obj, const char *base, const char *key,
+			    enum case_need need, char *pointer)
+{
+	case_pointer_key(pointer, base, key);
+	const json_t *v = json_object_get(obj, key);
+	if (!v && need == CASE_REQUIRED)
+		case_problem(r, pointer, "missing required key");
+	return v;
+}
+
+static int value_number(struct case_reader *r, const json_t *v, const char *pointer,
+			const struct case_range *range, double *out)
+{
+	if (!json_is_number(v)) {
+		case_problem(r, pointer, "expected a number, got %s", type_name(v));
+		return 0;
+	}
+	double x = json_number_value(v);
+	if (!isfinite(x)) {
+		case_problem(r, pointer, "expected a finite number");
+		return 0;
+	}
+	if (range && !case_check_range(r, pointer, x, range))
+		return 0;
+	*out = x;
+	return 1;
+}
+
+int case_read_number(struct case_reader *r, const json_t *obj, const char *base, const char *key,
+		     enum case_need need, const struct case_range *range, double *out)
+{
+	char pointer[CASE_POINTER_MAX];
+	const json_t *v = member(r, obj, base, key, need, pointer);
+	return v && value_number(r, v, pointer, range, out);
+}
+
+int case_read_int(struct case_reader *r, const json_t *obj, const char *base, const char *key,
+		  enum case_need need, int lo, int hi, int *out)
+{
+	char pointer[CASE_POINTER_MAX], got[CASE_NUMBER_SIZE];
+	const json_t *v = member(r, obj, base, key, need, pointer);
+	double x;
+	if (!v || !value_number(r, v, pointer, NULL, &x))
+		return 0;
+	if (x != floor(x)) {
+		case_problem(r, pointer, "expected an integer, got %s", case_format_number(got, x));
+		return 0;
+	}
+	struct case_range range = { BOUND_CLOSED, lo, BOUND_CLOSED, hi };
+	if (!case_check_range(r, pointer, x, &range))
+		return 0;
+	*out = (int)x;
+	return 1;
+}
+
+int case_read_bool(struct case_reader *r, const json_t *obj, const char *base, const char *key,
+		   enum case_need need, int *out)
+{
+	char pointer[CASE_POINTER_MAX];
+	const json_t *v = member(r, obj, base, key, need, pointer);
+	if (!v)
+		return 0;
+	if (!json_is_boolean(v)) {
+		case_problem(r, pointer, "expected a boolean, got %s", type_name(v));
+		return 0;
+	}
+	*out = json_is_true(v);
+	return 1;
+}
+
+/* Like case_read_string, also handing back the pointer for further checks. */
+static int read_string_at(struct case_reader *r, const json_t *obj, const char *base, const char *key,
+			  enum case_need need, const char **out, char *pointer)
+{
+	const json_t *v = member(r, obj, base, key, need, pointer);
+	if (!v)
+		return 0;
+	if (!json_is_string(v)) {
+		case_problem(r, pointer, "expected a string, got %s", type_name(v));
+		return 0;
+	}
+	*out = json_string_value(v);
+	return 1;
+}
+
+int case_read_string(struct case_reader *r, const json_t *obj, const char *base, const char *key,
+		     enum case_need need, const char **out)
+{
+	char pointer[CASE_POINTER_MAX];
+	return read_string_at(r, obj, base, key, need, out, pointer);
+}
+
+int case_read_choice(struct case_reader *r, const json_t *obj, const char *base, const char *key,
+		     enum case_need need, const char *const *names, int *out)
+{
+	char pointer[CASE_POINTER_MAX];
+	const char *s;
+	if (!read_string_at(r, obj, base, key, need, &s, pointer))
+		return 0;
+	for (int i = 0; names[i]; i++) {
+		if (strcmp(s, names[i]) == 0) {
+			*out = i;
+			return 1;
+		}
+	}
+	char list[512] = "", shown[CASE_QUOTE_SIZE];
+	size_t n = 0;
+	for (int i = 0; names[i] && n < sizeof list; i++)
+		n += (size_t)snprintf(list + n, sizeof list - n, "%s'%s'", i ? ", " : "", names[i]);
+	case_problem(r, pointer, "must be one of %s, got '%s'", list, case_quote(shown, s));
+	return 0;
+}
+
+static int is_name_char(char ch)
+{
+	return (ch >= 'a' && ch <= 'z') || (ch >= 'A' && ch <= 'Z') || (ch >= '0' && ch <= '9') ||
+	       ch == '_' || ch == '-';
+}
+
+int case_read_name(struct case_reader *r, const json_t *obj, const char *base, const char *key,
+		   enum case_need need, char *out, size_t size)
+{
+	char pointer[CASE_POINTER_MAX], shown[CASE_QUOTE_SIZE];
+	const char *s;
+	if (!read_string_at(r, obj, base, key, need, &s, pointer))
+		return 0;
+	size_t length = strlen(s);
+	if (length == 0 || length >= size) {
+		case_problem(r, pointer, "must be 1 to %zu characters long, got %zu", size - 1, length);
+		return 0;
+	}
+	for (const char *p = s; *p; p++) {
+		if (!is_name_char(*p)) {
+			case_problem(r, pointer, "must contain only letters, digits, '_' and '-', got '%s'",
+				     case_quote(shown, s));
+			return 0;
+		}
+	}
+	memcpy(out, s, length + 1);
+	return 1;
+}
+
+int case_value_vec2(struct case_reader *r, const json_t *v, const char *pointer,
+		    const struct case_range *range, double out[2])
+{
+	if (!json_is_array(v)) {
+		case_problem(r, pointer, "expected an array of 2 numbers, got %s", type_name(v));
+		return 0;
+	}
+	if (json_array_size(v) != 2) {
+		case_problem(r, pointer, "expected 2 numbers, got %zu", json_array_size(v));
+		return 0;
+	}
+	char item[CASE_POINTER_MAX];
+	int ok = 1;
+	double xy[2];
+	for (size_t i = 0; i < 2; i++) {
+		case_pointer_index(item, pointer, i);
+		ok &= value_number(r, json_array_get(v, i), item, range, &xy[i]);
+	}
+	if (ok) {
+		out[0] = xy[0];
+		out[1] = xy[1];
+	}
+	return ok;
+}
+
+int case_read_vec2(struct case_reader *r, const json_t *obj, const char *base, const char *key,
+		   enum case_need need, const struct case_range *range, double out[2])
+{
+	char pointer[CASE_POINTER_MAX];
+	const json_t *v = member(r, obj, base, key, need, pointer);
+	return v && case_value_vec2(r, v, pointer, range, out);
+}
+
+int case_expect_object(struct case_reader *r, const json_t *v, const char *pointer)
+{
+	if (json_is_object(v))
+		return 1;
+	case_problem(r, pointer, "expected an object, got %s", type_name(v));
+	return 0;
+}
+
+const json_t *case_read_object(struct case_reader *r, const json_t *obj, const char *base,
+			       const char *key, enum case_need need)
+{
+	char pointer[CASE_POINTER_MAX];
+	const json_t *v = member(r, obj, base, key, need, pointer);
+	return v && case_expect_object(r, v, pointer) ? v : NULL;
+}
+
+const json_t *case_read_array(struct case_reader *r, const json_t *obj, const char *base,
+			      const char *key, enum case_need need, size_t *count)
+{
+	char pointer[CASE_POINTER_MAX];
+	const json_t *v = member(r, obj, base, key, need, pointer);
+	*count = 0;
+	if (!v)
+		return NULL;
+	if (!json_is_array(v)) {
+		case_problem(r, pointer, "expected an array, got %s", type_name(v));
+		return NULL;
+	}
+	*count = json_array_size(v);
+	return v;
+}
+
+const json_t *case_array_item(const json_t *array, size_t index)
+{
+	return json_array_get(array, index);
+}

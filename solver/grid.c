@@ -1,0 +1,78 @@
+/* grid.c - background grid geometry and nodal field storage (see grid.h). */
+#include "grid.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+enum poro_status grid_init(struct grid *g, const struct case_grid *spec, struct poro_error *err)
+{
+	memset(g, 0, sizeof *g);
+	g->origin[0] = spec->origin[0];
+	g->origin[1] = spec->origin[1];
+	g->h = spec->cell_size;
+	g->inv_h = 1.0 / spec->cell_size;
+	for (int d = 0; d < 2; d++) {
+		double cells = spec->extent[d] / spec->cell_size;
+		g->cells[d] = (idx_t)lround(cells);
+		if (g->cells[d] < 3)
+			return poro_error_set(err, PORO_EINVAL, "/grid/extent/%d: fewer than 3 cells", d);
+		g->nodes[d] = g->cells[d] + 1;
+	}
+	g->node_count = g->nodes[0] * g->nodes[1];
+	g->cell_count = g->cells[0] * g->cells[1];
+	return PORO_OK;
+}
+
+idx_t grid_cell_of(const struct grid *g, const double x[2])
+{
+	double xi = (x[0] - g->origin[0]) * g->inv_h;
+	double eta = (x[1] - g->origin[1]) * g->inv_h;
+	if (!(xi >= 0 && eta >= 0 && xi <= g->cells[0] && eta <= g->cells[1]))
+		return -1;
+	idx_t i = (idx_t)xi, j = (idx_t)eta;
+	if (i == g->cells[0])
+		i--;
+	if (j == g->cells[1])
+		j--;
+	return i + j * g->cells[0];
+}
+
+/* Every nodal array with its width: one table so init and release agree. */
+#define GRID_DOUBLE_FIELDS(X)                                                                  \
+	X(mass_s, 1) X(mass_w, 1) X(mass_w_points, 1) X(mass_w_v, 1) X(v_s, 2) X(v_w, 2)       \
+	X(v_s_old, 2) X(v_w_old, 2) X(v_s_star, 2) X(v_w_star, 2) X(porosity, 1)               \
+	X(conductivity, 1) X(pressure, 1) X(dp, 1) X(force_w, 2) X(force, 2) X(rhs, 1)         \
+	X(correction_s, 2) X(correction_w, 2) X(du_s, 2)
+
+enum poro_status grid_fields_init(struct grid_fields *f, const struct grid *g, struct poro_error *err)
+{
+	memset(f, 0, sizeof *f);
+	size_t n = (size_t)g->node_count;
+	int ok = 1;
+#define ALLOC(name, width) if (ok) ok = (f->name = calloc(n * (width), sizeof(double))) != NULL;
+	GRID_DOUBLE_FIELDS(ALLOC)
+#undef ALLOC
+	if (ok)
+		ok = (f->cell_wet = calloc((size_t)g->cell_count, 1)) && (f->dirichlet = calloc(n, 1)) &&
+		     (f->fix_s = calloc(n, 1)) && (f->fix_w = calloc(n, 1));
+	if (!ok) {
+		grid_fields_release(f);
+		return poro_error_set(err, PORO_ENOMEM, "cannot allocate a grid of %ld nodes", (long)n);
+	}
+	return PORO_OK;
+}
+
+void grid_fields_release(struct grid_fields *f)
+{
+	if (!f)
+		return;
+#define FREE(name, width) free(f->name);
+	GRID_DOUBLE_FIELDS(FREE)
+#undef FREE
+	free(f->cell_wet);
+	free(f->dirichlet);
+	free(f->fix_s);
+	free(f->fix_w);
+	memset(f, 0, sizeof *f);
+}

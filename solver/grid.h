@@ -1,0 +1,64 @@
+/*
+ * grid.h - the uniform Cartesian background grid and the nodal fields of one step.
+ *
+ * Nodes are numbered i + j * nodes[0] (i along x, fastest). Square cells of size h. The grid is
+ * fixed for a run; nodal fields are reset at the start of every step (000 §4.5 step 2) and carry
+ * no information between steps.
+ *
+ * Symbols follow 000 §4.2: M_s, M_w nodal masses (Eqs. 44, 50), n_I nodal porosity (Eq. 46),
+ * k_I nodal conductivity (Eq. 47), v_s, v_w nodal velocities, v_s*, v_w* intermediate velocities
+ * (Eqs. 52-53), dp the pore-pressure increment p^{t+1} - p^t (Eq. 60).
+ */
+#ifndef PORO_GRID_H
+#define PORO_GRID_H
+
+#include "case.h"
+#include "particles.h"
+
+struct grid {
+	double origin[2];        /* m */
+	double h, inv_h;         /* cell size, m, and its inverse */
+	idx_t cells[2];          /* cells per direction */
+	idx_t nodes[2];          /* nodes per direction = cells + 1 */
+	idx_t node_count;
+	idx_t cell_count;
+};
+
+/* Nodal fields of one step; arrays of node_count (scalars) or 2 node_count (vectors, interleaved). */
+struct grid_fields {
+	double *mass_s;          /* M_sI, Eq. 44, kg/m */
+	double *mass_w;          /* M_wI, Eq. 50 */
+	double *mass_w_points;   /* sum S m_wp: water mass with one dof, for Eq. 77 weights */
+	double *mass_w_v;        /* sum S rho_w V0 (Eq. 51 denominator) */
+	double *v_s, *v_w;       /* v^t, then v^{t+1} after the correction (step 6) */
+	double *v_s_old, *v_w_old; /* v^t kept for the FLIP increment (step 7b) */
+	double *v_s_star, *v_w_star; /* intermediate velocities, Eqs. 52-53 */
+	double *porosity;        /* n_I, Eq. 46 (1 where there is no soil) */
+	double *conductivity;    /* k_I, Eq. 47, m/s */
+	double *pressure;        /* p^t_I: water-mass-weighted projection of point pressures, tension + */
+	double *dp;              /* p^{t+1} - p^t, Eq. 60 */
+	double *force_w;         /* F_w^ext - F_w^int, Eqs. 56-57, N/m */
+	double *force;           /* F^ext - F^int of the mixture, Eqs. 54-55 */
+	double *rhs;             /* Poisson right-hand side, Eq. 60 */
+	double *correction_s, *correction_w; /* G_s dp, G_w dp (Eqs. 67-68), N/m */
+	double *du_s;            /* MUSL displacement increment, step 8a, m */
+	signed char *cell_wet;   /* [cell_count] 1 if a pressure-carrying point lies in the cell */
+	signed char *dirichlet;  /* 1 if the pressure increment is prescribed at the node (free surface,
+				    drained face) */
+	unsigned char *fix_s;    /* velocity constraint bits per node: 1 = x fixed, 2 = y fixed (soil) */
+	unsigned char *fix_w;    /* same for water */
+};
+
+enum poro_status grid_init(struct grid *g, const struct case_grid *spec, struct poro_error *err);
+enum poro_status grid_fields_init(struct grid_fields *f, const struct grid *g, struct poro_error *err);
+void grid_fields_release(struct grid_fields *f);
+
+static inline idx_t grid_node(const struct grid *g, idx_t i, idx_t j)
+{
+	return i + j * g->nodes[0];
+}
+
+/* Cell index containing x, or -1 if x lies outside the grid. */
+idx_t grid_cell_of(const struct grid *g, const double x[2]);
+
+#endif

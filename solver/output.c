@@ -1,0 +1,749 @@
+/*
+ * output.c - the results writer (output.h): result.h5 through HDF5, result.xdmf through
+ * output_xdmf.c. The layout is documented for users in schemas/results.md; this is the only file
+ * that includes hdf5.h (STYLE rule 5).
+ *
+ * Format choices. The file keeps HDF5's default (earliest) format bounds, so every reader built on
+ * HDF5 1.8 or later opens it, and a killed run leaves no "open for writing" mark in the superblock
+ * (the newer superblock has one, and readers then refuse the file until h5clear). Strings are
+ * variable-length UTF-8 (h5py reads them as str); variable-length data lives in the global heap,
+ * so the /case "json" attribute is not bound by the 64 kB object-header limit. The writer takes no
+ * file lock, so a reader may open result.h5 while the run goes on and sees the last flushed state.
+ *
+ * Crash safety (output.h). A frame is written as new objects, the buffered probe samples are
+ * appended to chunked extendible datasets, the file is flushed and fsync'ed, and only then is
+ * result.xdmf rewritten to list the frame. Between two flushes the metadata already on disk is
+ * only added to, never moved: the /frames group is created with a local heap large enough for
+ * OUTPUT_FRAME_NAMES_HINT bytes of frame names, so adding a frame does not reallocate it, and the
+ * probe datasets grow in place. So a run killed while it writes a frame loses that frame only.
+ * What no HDF5 1.10 file without SWMR (which needs the newest format) can promise is a
+ * crash-consistent order of the writes inside one flush; the window is the flush itself, a few
+ * milliseconds per frame; in stress runs of the SIGKILL test in tests/solver/output_test.c (400
+ * kills at random moments, up to 120 frames into a run) no completed frame was ever damaged.
+ *
+ * Signs and units: SI throughout; pore pressure is stored internally tension positive
+ * (particles.h) and written positive in compression (-pressure).
+ */
+#include "output.h"
+
+#include <errno.h>
+#include <hdf5.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <time.h>
+#include <unistd.h>
+
+#include "output_xdmf.h"
+
+#define OUTPUT_PATH_MAX 512             /* object paths inside result.h5 */
+#define OUTPUT_FRAME_NAMES_HINT 65536   /* bytes of /frames link names reserved: 8192 frames */
+#define OUTPUT_PROBE_CHUNK 512          /* samples per chunk of a probe dataset */
+#define OUTPUT_SAMPLES_INITIAL 256      /* first capacity of the probe sample buffer */
+
+struct output_probe {
+	char *name;
+	char *units;
+	hid_t time;          /* /probes/<name>/time, open for the life of the file */
+	hid_t value;         /* /probes/<name>/value */
+};
+
+struct output {
+	char *dir;
+	char *path;                     /* DIR/result.h5, for messages */
+	hid_t file;                     /* -1 once closed */
+	hid_t string;                   /* variable-length UTF-8 string type */
+	int finished;
+
+	int probe_count;
+	struct output_probe *probes;    /* [probe_count] */
+	double *sample_time;            /* [sample_capacity] samples not yet in the file, s */
+	double *sample_value;           /* [sample_capacity * probe_count], sample-major */
+	size_t sample_count, sample_capacity;
+	hsize_t samples_written;        /* length of every probe dataset */
+
+	struct xdmf_frame *frames;      /* [frame_capacity] completed frames */
+	size_t frame_count, frame_capacity;
+	long frame_next;                /* sequence number of the next frame group */
+
+	double *scratch;                /* [scratch_capacity] derived fields of one set */
+	size_t scratch_capacity;
+};
+
+/* ---- errors --------------------------------------------------------------------------------- */
+
+/* HDF5's reason for the first failure since the last report: its innermost (most specific)
+ * description. Recorded by an automatic error handler, because the cleanup calls that follow a
+ * failure clear HDF5's error stack before the failure can be reported. */
+static char hdf5_reason[256];
+
+/* The innermost description, shortened: a system call's failure becomes its strerror text, which
+ * HDF5 embeds as "error message = '...'" among a timestamp, addresses and sizes. */
+static herr_t innermost(unsigned n, const H5E_error2_t *e, void *data)
+{
+	if (n != 0 || !e->desc)
+		return 0;
+	const char *key = "error message = '";
+	const char *from = strstr(e->desc, key);
+	from = from ? from + strlen(key) : e->desc;
+	size_t len = strcspn(from, from == e->desc ? "\n" : "'\n");
+	if (len >= sizeof hdf5_reason)
+		len = sizeof hdf5_reason - 1;
+	snprintf(data, sizeof hdf5_reason, "%.*s", (int)len, from);
+	return 0;
+}
+
+/* Installed with H5Eset_auto2 in place of HDF5's printer: the library never prints. */
+static herr_t record_reason(hid_t stack, void *data)
+{
+	if (!hdf5_reason[0])
+		H5Ewalk2(stack, H5E_WALK_UPWARD, innermost, hdf5_reason);
+	return 0;
+}
+
+static void reason_clear(void)
+{
+	hdf5_reason[0] = '\0';
+	H5Eclear2(H5E_DEFAULT);
+}
+
+/* Records "cannot VERB 'OBJECT' in 'DIR/result.h5': REASON", or without OBJECT (NULL) for the
+ * file as a whole "cannot VERB 'DIR/result.h5': REASON". */
+static enum poro_status h5_fail(const struct output *o, struct poro_error *err, const char *verb,
+				const char *object)
+{
+	char what[OUTPUT_PATH_MAX + 8];
+	if (object)
+		snprintf(what, sizeof what, "'%s' in ", object);
+	else
+		what[0] = '\0';
+	enum poro_status st = poro_error_set(err, PORO_EIO, "cannot %s %s'%s'%s%s", verb, what, o->path,
+					     hdf5_reason[0] ? ": " : "", hdf5_reason);
+	reason_clear();
+	return st;
+}
+
+static enum poro_status no_memory(struct poro_error *err, const char *what)
+{
+	return poro_error_set(err, PORO_ENOMEM, "cannot allocate %s", what);
+}
+
+/* ---- small HDF5 helpers: each returns < 0 on failure, the reason recorded in hdf5_reason ------ */
+
+static int attr_write(hid_t loc, const char *name, hid_t file_type, hid_t mem_type, const void *value)
+{
+	htri_t exists = H5Aexists(loc, name);
+	if (exists < 0 || (exists > 0 && H5Adelete(loc, name) < 0))
+		return -1;
+	hid_t space = H5Screate(H5S_SCALAR);
+	if (space < 0)
+		return -1;
+	hid_t a = H5Acreate2(loc, name, file_type, space, H5P_DEFAULT, H5P_DEFAULT);
+	int rc = a < 0 || H5Awrite(a, mem_type, value) < 0 ? -1 : 0;
+	if (a >= 0 && H5Aclose(a) < 0)
+		rc = -1;
+	H5Sclose(space);
+	return rc;
+}
+
+static int attr_string(const struct output *o, hid_t loc, const char *name, const char *value)
+{
+	return attr_write(loc, name, o->string, o->string, &value);
+}
+
+static int attr_double(hid_t loc, const char *name, double value)
+{
+	return attr_write(loc, name, H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, &value);
+}
+
+static int attr_long(hid_t loc, const char *name, long value)
+{
+	return attr_write(loc, name, H5T_STD_I64LE, H5T_NATIVE_LONG, &value);
+}
+
+/* Attributes on the object at an absolute path. */
+static int path_attr_string(const struct output *o, const char *path, const char *name, const char *value)
+{
+	hid_t obj = H5Oopen(o->file, path, H5P_DEFAULT);
+	if (obj < 0)
+		return -1;
+	int rc = attr_string(o, obj, name, value);
+	return H5Oclose(obj) < 0 ? -1 : rc;
+}
+
+static int new_group(hid_t loc, const char *path, size_t heap_hint)
+{
+	hid_t gcpl = H5Pcreate(H5P_GROUP_CREATE);
+	if (gcpl < 0)
+		return -1;
+	int rc = heap_hint && H5Pset_local_heap_size_hint(gcpl, heap_hint) < 0 ? -1 : 0;
+	hid_t g = rc ? -1 : H5Gcreate2(loc, path, H5P_DEFAULT, gcpl, H5P_DEFAULT);
+	if (g < 0 || H5Gclose(g) < 0)
+		rc = -1;
+	H5Pclose(gcpl);
+	return rc;
+}
+
+/* A contiguous dataset of n rows and width columns (width 1: 1-D) of file_type, written from data
+ * in mem_type, with a "units" attribute when units is not NULL. */
+static int put_dataset(const struct output *o, const char *path, hsize_t n, hsize_t width, hid_t file_type,
+		       hid_t mem_type, const void *data, const char *units)
+{
+	hsize_t dims[2] = {n, width};
+	hid_t space = H5Screate_simple(width == 1 ? 1 : 2, dims, NULL);
+	if (space < 0)
+		return -1;
+	hid_t ds = H5Dcreate2(o->file, path, file_type, space, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
+	int rc = ds < 0 ? -1 : 0;
+	if (!rc && n > 0 && H5Dwrite(ds, mem_type, H5S_ALL, H5S_ALL, H5P_DEFAULT, data) < 0)
+		rc = -1;
+	if (!rc && units && attr_string(o, ds, "units", units) < 0)
+		rc = -1;
+	if (ds >= 0 && H5Dclose(ds) < 0)
+		rc = -1;
+	H5Sclose(space);
+	return rc;
+}
+
+/* ---- one point set of a frame ------------------------------------------------------------------ */
+
+/* How a written field is obtained from the particle arrays. */
+enum derive {
+	AS_STORED,         /* the array itself */
+	DISPLACEMENT,      /* x - x0, N x 2 */
+	COMPRESSION,       /* -pressure: positive in compression */
+	PAD_XYZ,           /* an N x 2 array padded with z = 0 to N x 3, for ParaView */
+	DISPLACEMENT_XYZ,  /* x - x0 padded the same way */
+	FULL_TENSOR,       /* (xx, yy, xy, zz) as the full 3 x 3 tensor, row-major, for ParaView */
+};
+
+struct field {
+	const char *name;
+	int width;
+	const char *units;
+	enum derive derive;
+	size_t array;       /* offsetof(struct particles, source array) */
+	int soil_only;      /* skeleton state: the soil set only */
+};
+
+#define ARRAY(member) offsetof(struct particles, member)
+
+/* The datasets of soil/ and water/ (schemas/results.md). The last three are copies in the shapes
+ * ParaView's XDMF readers need (3-component vectors, 9-component tensors); output_xdmf.c
+ * reads them, pore_pressure, porosity and plastic_strain by these names. */
+static const struct field set_fields[] = {
+	{"x", 2, "m", AS_STORED, ARRAY(x), 0},
+	{"v", 2, "m/s", AS_STORED, ARRAY(v), 0},
+	{"displacement", 2, "m", DISPLACEMENT, ARRAY(x), 0},
+	{"pore_pressure", 1, "Pa", COMPRESSION, ARRAY(pressure), 0},
+	{"porosity", 1, "1", AS_STORED, ARRAY(porosity), 0},
+	{"volume", 1, "m^3/m", AS_STORED, ARRAY(volume), 0},
+	{"mass", 1, "kg/m", AS_STORED, ARRAY(mass), 0},
+	{"stress", 4, "Pa", AS_STORED, ARRAY(stress), 1},
+	{"plastic_strain", 1, "1", AS_STORED, ARRAY(plastic_strain), 1},
+	{"displacement3", 3, "m", DISPLACEMENT_XYZ, ARRAY(x), 0},
+	{"v3", 3, "m/s", PAD_XYZ, ARRAY(v), 0},
+	{"stress9", 9, "Pa", FULL_TENSOR, ARRAY(stress), 1},
+};
+
+static const double *array_of(const struct particles *p, size_t array)
+{
+	return *(double *const *)((const char *)p + array);
+}
+
+/* The values of field f, either the stored array or derived into scratch [9n]. */
+static const double *field_values(const struct field *f, const struct particles *p, double *scratch)
+{
+	const double *a = array_of(p, f->array);
+	idx_t n = p->n;
+	switch (f->derive) {
+	case AS_STORED:
+		return a;
+	case DISPLACEMENT:
+		for (idx_t i = 0; i < 2 * n; i++)
+			scratch[i] = p->x[i] - p->x0[i];
+		return scratch;
+	case COMPRESSION:
+		for (idx_t i = 0; i < n; i++)
+			scratch[i] = -a[i];
+		return scratch;
+	case PAD_XYZ:
+	case DISPLACEMENT_XYZ:
+		for (idx_t i = 0; i < n; i++) {
+			int shift = f->derive == DISPLACEMENT_XYZ;
+			scratch[3 * i] = a[2 * i] - (shift ? p->x0[2 * i] : 0.0);
+			scratch[3 * i + 1] = a[2 * i + 1] - (shift ? p->x0[2 * i + 1] : 0.0);
+			scratch[3 * i + 2] = 0.0;
+		}
+		return scratch;
+	case FULL_TENSOR:
+		for (idx_t i = 0; i < n; i++) {
+			double xx = a[4 * i], yy = a[4 * i + 1], xy = a[4 * i + 2], zz = a[4 * i + 3];
+			double full[9] = {xx, xy, 0.0, xy, yy, 0.0, 0.0, 0.0, zz};
+			memcpy(scratch + 9 * i, full, sizeof full);
+		}
+		return scratch;
+	}
+	return a;
+}
+
+static enum poro_status scratch_reserve(struct output *o, size_t count, struct poro_error *err)
+{
+	if (count <= o->scratch_capacity)
+		return PORO_OK;
+	double *s = realloc(o->scratch, count * sizeof *s);
+	if (!s)
+		return no_memory(err, "the output scratch space");
+	o->scratch = s;
+	o->scratch_capacity = count;
+	return PORO_OK;
+}
+
+/* The Polyvertex connectivity 0 .. n-1 that result.xdmf needs for a set of n points, written once
+ * per distinct n. */
+static enum poro_status points_index(struct output *o, long n, struct poro_error *err)
+{
+	char path[OUTPUT_PATH_MAX];
+	snprintf(path, sizeof path, OUTPUT_POINTS_FORMAT, n);
+	htri_t exists = H5Lexists(o->file, path, H5P_DEFAULT);
+	if (exists > 0)
+		return PORO_OK;
+	if (exists < 0)
+		return h5_fail(o, err, "look up", path);
+	int32_t *index = malloc((n > 0 ? (size_t)n : 1) * sizeof *index);
+	if (!index)
+		return no_memory(err, "the xdmf point index");
+	for (long i = 0; i < n; i++)
+		index[i] = (int32_t)i;
+	int rc = put_dataset(o, path, (hsize_t)n, 1, H5T_STD_I32LE, H5T_NATIVE_INT32, index, NULL);
+	free(index);
+	return rc < 0 ? h5_fail(o, err, "write", path) : PORO_OK;
+}
+
+static enum poro_status write_set(struct output *o, const char *frame_path, const char *set,
+				  const struct particles *p, struct poro_error *err)
+{
+	int soil = strcmp(set, "soil") == 0;
+	char group[OUTPUT_PATH_MAX / 2], path[OUTPUT_PATH_MAX];
+	snprintf(group, sizeof group, "%s/%s", frame_path, set);
+	if (!p->x || !p->x0 || !p->v || !p->pressure || !p->porosity || !p->volume || !p->mass ||
+	    (soil && (!p->stress || !p->plastic_strain)))
+		return poro_error_set(err, PORO_EINVAL, "cannot write '%s': the point set lacks an array",
+				      group);
+	enum poro_status st = scratch_reserve(o, 9 * (size_t)p->n, err);
+	if (st)
+		return st;
+	if (new_group(o->file, group, 0) < 0)
+		return h5_fail(o, err, "create", group);
+	for (size_t k = 0; k < sizeof set_fields / sizeof set_fields[0]; k++) {
+		const struct field *f = &set_fields[k];
+		if (f->soil_only && !soil)
+			continue;
+		snprintf(path, sizeof path, "%s/%s", group, f->name);
+		const double *values = field_values(f, p, o->scratch);
+		if (put_dataset(o, path, (hsize_t)p->n, (hsize_t)f->width, H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE,
+				values, f->units) < 0)
+			return h5_fail(o, err, "write", path);
+	}
+	snprintf(path, sizeof path, "%s/stress", group);
+	if (soil && path_attr_string(o, path, "components", "xx yy xy zz") < 0)
+		return h5_fail(o, err, "write", path);
+	return points_index(o, p->n, err);
+}
+
+/* ---- probes ------------------------------------------------------------------------------------ */
+
+static hid_t probe_dataset(const struct output *o, const char *path, const char *units)
+{
+	hsize_t zero = 0, unlimited = H5S_UNLIMITED, chunk = OUTPUT_PROBE_CHUNK;
+	hid_t space = H5Screate_simple(1, &zero, &unlimited);
+	hid_t dcpl = H5Pcreate(H5P_DATASET_CREATE);
+	hid_t ds = -1;
+	if (space >= 0 && dcpl >= 0 && H5Pset_chunk(dcpl, 1, &chunk) >= 0)
+		ds = H5Dcreate2(o->file, path, H5T_IEEE_F64LE, space, H5P_DEFAULT, dcpl, H5P_DEFAULT);
+	if (ds >= 0 && attr_string(o, ds, "units", units) < 0) {
+		H5Dclose(ds);
+		ds = -1;
+	}
+	if (dcpl >= 0)
+		H5Pclose(dcpl);
+	if (space >= 0)
+		H5Sclose(space);
+	return ds;
+}
+
+static enum poro_status probes_create(struct output *o, struct poro_error *err)
+{
+	char path[OUTPUT_PATH_MAX];
+	for (int j = 0; j < o->probe_count; j++) {
+		struct output_probe *pr = &o->probes[j];
+		snprintf(path, sizeof path, "/probes/%s", pr->name);
+		if (new_group(o->file, path, 0) < 0)
+			return h5_fail(o, err, "create", path);
+		snprintf(path, sizeof path, "/probes/%s/time", pr->name);
+		if ((pr->time = probe_dataset(o, path, "s")) < 0)
+			return h5_fail(o, err, "create", path);
+		snprintf(path, sizeof path, "/probes/%s/value", pr->name);
+		if ((pr->value = probe_dataset(o, path, pr->units)) < 0)
+			return h5_fail(o, err, "create", path);
+	}
+	return PORO_OK;
+}
+
+/* Writes count values, taken every stride from values, at [start, start + count) of ds, extending
+ * it to start + count. */
+static int probe_append(hid_t ds, hsize_t start, hsize_t count, const double *values, hsize_t stride)
+{
+	hsize_t end = start + count, mem_n = (count - 1) * stride + 1, zero = 0, one = 1;
+	if (H5Dset_extent(ds, &end) < 0)
+		return -1;
+	hid_t file_space = H5Dget_space(ds);
+	hid_t mem_space = H5Screate_simple(1, &mem_n, NULL);
+	int rc = file_space < 0 || mem_space < 0 ||
+		 H5Sselect_hyperslab(file_space, H5S_SELECT_SET, &start, NULL, &count, NULL) < 0 ||
+		 H5Sselect_hyperslab(mem_space, H5S_SELECT_SET, &zero, &stride, &count, &one) < 0 ||
+		 H5Dwrite(ds, H5T_NATIVE_DOUBLE, mem_space, file_space, H5P_DEFAULT, values) < 0 ? -1 : 0;
+	if (mem_space >= 0)
+		H5Sclose(mem_space);
+	if (file_space >= 0)
+		H5Sclose(file_space);
+	return rc;
+}
+
+/* Moves the buffered samples into the file. Every probe is written at the same offset, so a
+ * retry after a partial failure rewrites the same range. */
+static enum poro_status probes_write(struct output *o, struct poro_error *err)
+{
+	if (o->sample_count == 0)
+		return PORO_OK;
+	char path[OUTPUT_PATH_MAX];
+	hsize_t n = o->sample_count, stride = (hsize_t)o->probe_count;
+	for (int j = 0; j < o->probe_count; j++) {
+		struct output_probe *pr = &o->probes[j];
+		if (probe_append(pr->time, o->samples_written, n, o->sample_time, 1) < 0) {
+			snprintf(path, sizeof path, "/probes/%s/time", pr->name);
+			return h5_fail(o, err, "write", path);
+		}
+		if (probe_append(pr->value, o->samples_written, n, o->sample_value + j, stride) < 0) {
+			snprintf(path, sizeof path, "/probes/%s/value", pr->name);
+			return h5_fail(o, err, "write", path);
+		}
+	}
+	o->samples_written += n;
+	o->sample_count = 0;
+	return PORO_OK;
+}
+
+enum poro_status output_probe_sample(struct output *o, double time, const double *values,
+				     struct poro_error *err)
+{
+	if (!o || o->finished)
+		return poro_error_set(err, PORO_EINVAL, "cannot sample probes: the output is closed");
+	if (o->probe_count == 0)
+		return PORO_OK;
+	if (o->sample_count == o->sample_capacity) {
+		size_t cap = o->sample_capacity ? 2 * o->sample_capacity : OUTPUT_SAMPLES_INITIAL;
+		double *t = realloc(o->sample_time, cap * sizeof *t);
+		if (t)
+			o->sample_time = t;
+		double *v = t ? realloc(o->sample_value, cap * (size_t)o->probe_count * sizeof *v) : NULL;
+		if (!v)
+			return no_memory(err, "the probe sample buffer");
+		o->sample_value = v;
+		o->sample_capacity = cap;
+	}
+	o->sample_time[o->sample_count] = time;
+	memcpy(o->sample_value + o->sample_count * (size_t)o->probe_count, values,
+	       (size_t)o->probe_count * sizeof *values);
+	o->sample_count++;
+	return PORO_OK;
+}
+
+/* ---- file -------------------------------------------------------------------------------------- */
+
+/* Makes what has been written so far durable: HDF5's caches to the kernel, then the kernel's to disk. */
+static enum poro_status file_sync(struct output *o, struct poro_error *err)
+{
+	void *handle = NULL;
+	if (H5Fflush(o->file, H5F_SCOPE_GLOBAL) < 0 || H5Fget_vfd_handle(o->file, H5P_DEFAULT, &handle) < 0)
+		return h5_fail(o, err, "flush", NULL);
+	if (fsync(*(int *)handle) != 0) /* the sec2 driver's handle is its file descriptor */
+		return poro_error_set(err, PORO_EIO, "cannot flush '%s': %s", o->path, strerror(errno));
+	return PORO_OK;
+}
+
+static void iso_time_now(char *buf, size_t size)
+{
+	time_t now = time(NULL);
+	struct tm tm;
+	if (!gmtime_r(&now, &tm) || !strftime(buf, size, "%Y-%m-%dT%H:%M:%SZ", &tm))
+		snprintf(buf, size, "unknown");
+}
+
+static enum poro_status file_create(struct output *o, const char *case_json, const char *solver_version,
+				    struct poro_error *err)
+{
+	hid_t fapl = H5Pcreate(H5P_FILE_ACCESS);
+	/* STRONG: H5Fclose closes every object left open, so the file is really closed;
+	 * no locking: readers may open the file during the run */
+	if (fapl >= 0 && H5Pset_fclose_degree(fapl, H5F_CLOSE_STRONG) >= 0 &&
+	    H5Pset_file_locking(fapl, 0, 1) >= 0)
+		o->file = H5Fcreate(o->path, H5F_ACC_TRUNC, H5P_DEFAULT, fapl);
+	if (fapl >= 0)
+		H5Pclose(fapl);
+	if (o->file < 0)
+		return h5_fail(o, err, "create", NULL);
+	o->string = H5Tcopy(H5T_C_S1);
+	if (o->string < 0 || H5Tset_size(o->string, H5T_VARIABLE) < 0 ||
+	    H5Tset_cset(o->string, H5T_CSET_UTF8) < 0)
+		return h5_fail(o, err, "create", "string type");
+	if (new_group(o->file, "/case", 0) < 0 || path_attr_string(o, "/case", "json", case_json) < 0)
+		return h5_fail(o, err, "write", "/case");
+	char now[32];
+	iso_time_now(now, sizeof now);
+	if (new_group(o->file, "/run", 0) < 0 ||
+	    path_attr_string(o, "/run", "solver_version", solver_version) < 0 ||
+	    path_attr_string(o, "/run", "start_time", now) < 0 ||
+	    path_attr_string(o, "/run", "status", "running") < 0)
+		return h5_fail(o, err, "write", "/run");
+	if (new_group(o->file, "/frames", OUTPUT_FRAME_NAMES_HINT) < 0)
+		return h5_fail(o, err, "create", "/frames");
+	if (new_group(o->file, "/probes", 0) < 0)
+		return h5_fail(o, err, "create", "/probes");
+	if (new_group(o->file, "/xdmf", 0) < 0)
+		return h5_fail(o, err, "create", "/xdmf");
+	enum poro_status st = probes_create(o, err);
+	return st ? st : file_sync(o, err);
+}
+
+/* Probe names become HDF5 link names: no '/', not "." or "..", unique. */
+static enum poro_status check_probes(int count, const char *const *names, const char *const *units,
+				     struct poro_error *err)
+{
+	if (count < 0 || (count > 0 && (!names || !units)))
+		return poro_error_set(err, PORO_EINVAL, "invalid probe list");
+	for (int j = 0; j < count; j++) {
+		const char *s = names[j];
+		if (!s || !*s || strchr(s, '/') || !strcmp(s, ".") || !strcmp(s, "..") ||
+		    strlen(s) > OUTPUT_PATH_MAX / 2)
+			return poro_error_set(err, PORO_EINVAL, "invalid probe name '%s'", s ? s : "(null)");
+		if (!units[j])
+			return poro_error_set(err, PORO_EINVAL, "probe '%s' has no units", s);
+		for (int k = 0; k < j; k++)
+			if (!strcmp(names[k], s))
+				return poro_error_set(err, PORO_EINVAL, "duplicate probe name '%s'", s);
+	}
+	return PORO_OK;
+}
+
+static char *copy(const char *s)
+{
+	char *c = malloc(strlen(s) + 1);
+	return c ? strcpy(c, s) : NULL;
+}
+
+static enum poro_status probes_init(struct output *o, int count, const char *const *names,
+				    const char *const *units, struct poro_error *err)
+{
+	o->probes = calloc(count > 0 ? (size_t)count : 1, sizeof *o->probes);
+	if (!o->probes)
+		return no_memory(err, "the probe list");
+	o->probe_count = count;
+	for (int j = 0; j < count; j++) {
+		o->probes[j].time = o->probes[j].value = H5I_INVALID_HID;
+		o->probes[j].name = copy(names[j]);
+		o->probes[j].units = copy(units[j]);
+		if (!o->probes[j].name || !o->probes[j].units)
+			return no_memory(err, "the probe list");
+	}
+	return PORO_OK;
+}
+
+enum poro_status output_create(struct output **out, const char *dir, const char *case_json,
+			       const char *solver_version, int probe_count, const char *const *probe_names,
+			       const char *const *probe_units, struct poro_error *err)
+{
+	*out = NULL;
+	if (!dir || !case_json || !solver_version)
+		return poro_error_set(err, PORO_EINVAL, "cannot create results: no directory, case or version");
+	enum poro_status st = check_probes(probe_count, probe_names, probe_units, err);
+	if (st)
+		return st;
+	struct stat sb;
+	if (stat(dir, &sb) != 0)
+		return poro_error_set(err, PORO_EIO, "cannot create results in '%s': %s", dir, strerror(errno));
+	if (!S_ISDIR(sb.st_mode))
+		return poro_error_set(err, PORO_EIO, "cannot create results in '%s': not a directory", dir);
+	/* the library never prints: HDF5's error reports are recorded for h5_fail() instead */
+	H5Eset_auto2(H5E_DEFAULT, record_reason, NULL);
+	reason_clear();
+
+	struct output *o = calloc(1, sizeof *o);
+	if (!o)
+		return no_memory(err, "the output writer");
+	o->file = o->string = H5I_INVALID_HID;
+	size_t len = strlen(dir) + sizeof "/" OUTPUT_H5_NAME;
+	o->dir = copy(dir);
+	o->path = malloc(len);
+	if (!o->dir || !o->path) {
+		output_destroy(&o);
+		return no_memory(err, "the output writer");
+	}
+	snprintf(o->path, len, "%s/%s", dir, OUTPUT_H5_NAME);
+	st = probes_init(o, probe_count, probe_names, probe_units, err);
+	if (!st)
+		st = file_create(o, case_json, solver_version, err);
+	if (st) {
+		output_destroy(&o);
+		return st;
+	}
+	*out = o;
+	return PORO_OK;
+}
+
+/* ---- frames ------------------------------------------------------------------------------------ */
+
+static enum poro_status frame_remember(struct output *o, const struct output_frame *f, struct poro_error *err)
+{
+	if (o->frame_count == o->frame_capacity) {
+		size_t cap = o->frame_capacity ? 2 * o->frame_capacity : 64;
+		struct xdmf_frame *fr = realloc(o->frames, cap * sizeof *fr);
+		if (!fr)
+			return no_memory(err, "the frame list");
+		o->frames = fr;
+		o->frame_capacity = cap;
+	}
+	o->frames[o->frame_count++] = (struct xdmf_frame){
+		.index = o->frame_next,
+		.time = f->time,
+		.soil_n = f->soil->n,
+		.water_n = f->water ? f->water->n : -1,
+	};
+	return PORO_OK;
+}
+
+static enum poro_status frame_groups(struct output *o, const char *path, const struct output_frame *f,
+				     struct poro_error *err)
+{
+	if (new_group(o->file, path, 0) < 0)
+		return h5_fail(o, err, "create", path);
+	hid_t g = H5Gopen2(o->file, path, H5P_DEFAULT);
+	int rc = g < 0 || attr_double(g, "time", f->time) < 0 || attr_long(g, "step", f->step) < 0 ? -1 : 0;
+	if (g >= 0 && H5Gclose(g) < 0)
+		rc = -1;
+	if (rc < 0)
+		return h5_fail(o, err, "write", path);
+	enum poro_status st = write_set(o, path, "soil", f->soil, err);
+	if (!st && f->water)
+		st = write_set(o, path, "water", f->water, err);
+	return st;
+}
+
+enum poro_status output_frame_write(struct output *o, const struct output_frame *f, struct poro_error *err)
+{
+	if (!o || o->finished)
+		return poro_error_set(err, PORO_EINVAL, "cannot write a frame: the output is closed");
+	if (!f || !f->soil)
+		return poro_error_set(err, PORO_EINVAL, "cannot write a frame without a soil point set");
+	char path[OUTPUT_PATH_MAX];
+	snprintf(path, sizeof path, OUTPUT_FRAME_FORMAT, o->frame_next);
+	reason_clear();
+	enum poro_status st = frame_groups(o, path, f, err);
+	if (!st)
+		st = probes_write(o, err);
+	if (!st)
+		st = file_sync(o, err);
+	if (st) {
+		/* best effort: leave no half frame behind, so the next one can take its number */
+		H5Ldelete(o->file, path, H5P_DEFAULT);
+		reason_clear();
+		return st;
+	}
+	st = frame_remember(o, f, err);
+	o->frame_next++;
+	return st ? st : xdmf_write(o->dir, o->frames, o->frame_count, err);
+}
+
+/* ---- end of the run ------------------------------------------------------------------------------ */
+
+/* Closes everything; returns < 0 when HDF5 could not close the file cleanly. */
+static int file_close(struct output *o)
+{
+	int rc = 0;
+	for (int j = 0; j < o->probe_count && o->probes; j++) {
+		if (o->probes[j].time >= 0)
+			H5Dclose(o->probes[j].time);
+		if (o->probes[j].value >= 0)
+			H5Dclose(o->probes[j].value);
+		o->probes[j].time = o->probes[j].value = H5I_INVALID_HID;
+	}
+	if (o->string >= 0)
+		H5Tclose(o->string);
+	if (o->file >= 0 && H5Fclose(o->file) < 0)
+		rc = -1;
+	o->string = o->file = H5I_INVALID_HID;
+	return rc;
+}
+
+static enum poro_status run_attributes(struct output *o, const char *status, long steps, long particles,
+				       double wall_seconds, struct poro_error *err)
+{
+	char now[32];
+	iso_time_now(now, sizeof now);
+	hid_t run = H5Gopen2(o->file, "/run", H5P_DEFAULT);
+	int rc = run < 0 || attr_string(o, run, "end_time", now) < 0 ||
+		 attr_double(run, "wall_seconds", wall_seconds) < 0 || attr_long(run, "steps", steps) < 0 ||
+		 attr_long(run, "particles", particles) < 0 ||
+		 attr_string(o, run, "status", status) < 0 ? -1 : 0;
+	if (run >= 0 && H5Gclose(run) < 0)
+		rc = -1;
+	return rc < 0 ? h5_fail(o, err, "write", "/run") : PORO_OK;
+}
+
+enum poro_status output_finish(struct output *o, const char *status, long steps, long particles,
+			       double wall_seconds, struct poro_error *err)
+{
+	if (!o || o->finished)
+		return poro_error_set(err, PORO_EINVAL, "cannot finish the output: it is closed");
+	if (!status || (strcmp(status, "succeeded") && strcmp(status, "failed")))
+		return poro_error_set(err, PORO_EINVAL, "invalid run status '%s'", status ? status : "(null)");
+	reason_clear();
+	enum poro_status st = probes_write(o, err);
+	if (!st)
+		st = run_attributes(o, status, steps, particles, wall_seconds, err);
+	if (!st)
+		st = file_sync(o, err);
+	o->finished = 1;
+	if (file_close(o) < 0 && !st)
+		st = h5_fail(o, err, "close", NULL);
+	reason_clear();
+	return st;
+}
+
+void output_destroy(struct output **op)
+{
+	if (!op || !*op)
+		return;
+	struct output *o = *op;
+	if (o->file >= 0 && !o->finished) {
+		/* an abandoned run: keep the probe samples, leave /run status "running" */
+		probes_write(o, NULL);
+	}
+	file_close(o);
+	reason_clear();
+	for (int j = 0; j < o->probe_count && o->probes; j++) {
+		free(o->probes[j].name);
+		free(o->probes[j].units);
+	}
+	free(o->probes);
+	free(o->sample_time);
+	free(o->sample_value);
+	free(o->frames);
+	free(o->scratch);
+	free(o->dir);
+	free(o->path);
+	free(o);
+	*op = NULL;
+}

@@ -1,0 +1,37 @@
+/*
+ * output_xdmf.h - private to the results writer (output.c): the names both halves of it agree on,
+ * and result.xdmf, the XML index that lets ParaView open result.h5.
+ *
+ * output.c writes the heavy data into result.h5 and keeps one struct xdmf_frame per completed
+ * frame; after every frame it calls xdmf_write(), which rewrites result.xdmf atomically (temporary
+ * file, fsync, rename) so that the index never names a frame that is not yet flushed to result.h5.
+ * The dataset names written here must match the field table in output.c; schemas/results.md is
+ * the user's description of both.
+ */
+#ifndef PORO_OUTPUT_XDMF_H
+#define PORO_OUTPUT_XDMF_H
+
+#include <stddef.h>
+
+#include "error.h"
+
+#define OUTPUT_H5_NAME "result.h5"
+#define OUTPUT_XDMF_NAME "result.xdmf"
+#define OUTPUT_XDMF_TMP_NAME ".result.xdmf.tmp"
+#define OUTPUT_FRAME_FORMAT "/frames/%06ld"  /* frame group of a sequence number */
+#define OUTPUT_POINTS_FORMAT "/xdmf/points_%ld" /* 0 .. n-1, the Polyvertex connectivity for n points */
+
+/* One completed frame as result.xdmf lists it. */
+struct xdmf_frame {
+	long index;       /* sequence number: the group is OUTPUT_FRAME_FORMAT of it */
+	double time;      /* s */
+	long soil_n;      /* points in soil/ */
+	long water_n;     /* points in water/; -1 when the frame has no water group (single point) */
+};
+
+/* Rewrites DIR/result.xdmf to list frames[0 .. count-1]: writes DIR/.result.xdmf.tmp, fsyncs it
+ * and renames it over result.xdmf. Returns PORO_EIO, naming the file, on failure. */
+enum poro_status xdmf_write(const char *dir, const struct xdmf_frame *frames, size_t count,
+			    struct poro_error *err);
+
+#endif

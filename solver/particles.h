@@ -1,0 +1,74 @@
+/*
+ * particles.h - one set of material points in structure-of-arrays storage.
+ *
+ * A simulation has a soil set and, for the double-point formulation (000 §2), a water set. In the
+ * single-point formulation the water phase rides on the soil points: the water set then aliases
+ * the soil set's position, volume, porosity and shape-function arrays (alias_of != NULL) and owns
+ * only its velocity, mass and pressure.
+ *
+ * Conventions (DESIGN §2.4): 2-D plane strain, per unit thickness (a "volume" is an area times 1 m).
+ * Tensors are stored row-major; symmetric stresses as 4 components (xx, yy, xy, zz).
+ * Internally pore pressure follows the paper's sign: tension positive (000 §2, after Eq. 6), so
+ * compression is negative; output converts to the physical pressure, positive in compression.
+ *
+ * Arrays are allocated once at create with capacity n and never during a step (STYLE rule 3).
+ */
+#ifndef PORO_PARTICLES_H
+#define PORO_PARTICLES_H
+
+#include <stdint.h>
+
+#include "error.h"
+
+typedef int32_t idx_t;            /* matches CHOLMOD's int interface */
+
+#define SHAPE_SUPPORT_MAX 4         /* support nodes per direction: 2 linear, 3 quadratic, 4 cubic */
+#define SHAPE_NODES_MAX (SHAPE_SUPPORT_MAX * SHAPE_SUPPORT_MAX)
+#define STATE_MAX 8                 /* model internal variables per point */
+
+struct particles {
+	idx_t n;                    /* number of points */
+	const struct particles *alias_of; /* single-point water set: the soil set it rides on */
+
+	double *x;                  /* [2n] current position, m */
+	double *x0;                 /* [2n] initial position, m (displacement = x - x0) */
+	double *v;                  /* [2n] velocity, m/s */
+	double *mass;               /* [n] kg per m thickness; soil: (1-n0) rho_s V0 (Eq. 33), constant;
+				       water: n0 rho_w V0 (Eq. 37) in double point, constant */
+	double *volume;             /* [n] current volume V^t, m^3 per m */
+	double *volume0;            /* [n] initial volume V^0 */
+	double *porosity;           /* [n] soil: n_sp (step 8f); water: soil porosity projected, n_wp (Eq. 48) */
+	double *porosity0;          /* [n] initial porosity n0 */
+	double *conductivity;       /* [n] hydraulic conductivity k, m/s (soil set) */
+	double *pressure;           /* [n] pore water pressure p_w, Pa, TENSION POSITIVE (internal sign) */
+	int *body;                  /* [n] index of the case body the point came from */
+
+	/* soil skeleton state (soil set only; NULL for the water set) */
+	double *stress;             /* [4n] effective Cauchy stress sigma' (xx, yy, xy, zz), Pa, tension + */
+	double *F;                  /* [4n] deformation gradient (xx, xy, yx, yy); F_zz = 1 in plane strain */
+	double *Be;                 /* [4n] elastic left Cauchy-Green tensor (xx, yy, xy, zz), Eq. 70 */
+	double *state;              /* [STATE_MAX n] constitutive internal variables */
+	double *plastic_strain;     /* [n] accumulated plastic strain (0 for elastic models) */
+	double *dF;                 /* [4n] scratch: deformation gradient increment of this step */
+	double *surface;            /* [2n] loaded-face length vector N dA in the reference configuration,
+				       m per m (zero for interior points); see loads.c */
+	int *surface_load;          /* [n] index of the case load acting on the point, -1 if none */
+
+	/* shape-function cache, filled once per step by shape_evaluate() (000 §4.5 step 1) */
+	int support;                /* nodes per direction of the current shape function */
+	idx_t *node0;               /* [n] linear index of the lower-left support node */
+	double *w;                  /* [SHAPE_NODES_MAX n] weights S_Ip, node order i fastest */
+	double *dw;                 /* [2 SHAPE_NODES_MAX n] gradients dS/dx, dS/dy interleaved */
+};
+
+/* Allocates a set of n points with every array zeroed; soil sets also get the skeleton arrays.
+ * Returns PORO_ENOMEM on failure with nothing allocated. */
+enum poro_status particles_init(struct particles *p, idx_t n, int with_skeleton, struct poro_error *err);
+
+/* Makes w a single-point water set riding on soil: shares x, x0, volume, volume0, porosity,
+ * porosity0, body and the shape cache; owns v, mass, pressure. */
+enum poro_status particles_init_alias(struct particles *w, const struct particles *soil, struct poro_error *err);
+
+void particles_release(struct particles *p);
+
+#endif

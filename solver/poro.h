@@ -1,0 +1,74 @@
+/*
+ * poro.h - the public solver API: build a simulation from a case, step it, read its state.
+ *
+ * The library knows nothing of HTTP, SQL or queues (DESIGN §1). Typical use:
+ *
+ *     struct case_spec *c; struct poro_error err = {0}; struct sim *s;
+ *     if (case_load_file(path, &c, &err)) ...report err.message, exit 2...
+ *     if (sim_create(&s, c, &err)) ...
+ *     while (!sim_done(s)) if (sim_step(s)) ...report sim_error(s)->message...
+ *     sim_destroy(&s); case_destroy(&c);
+ *
+ * sim_run() does the loop with result files and progress reporting (the poro-solve driver).
+ * A sim borrows the case: keep it alive until sim_destroy().
+ */
+#ifndef PORO_H
+#define PORO_H
+
+#include "case.h"
+#include "error.h"
+#include "particles.h"
+
+struct sim;
+
+/* Builds grid, particles, materials and solver workspaces for a validated case. Everything a
+ * step needs is allocated here. */
+enum poro_status sim_create(struct sim **s, const struct case_spec *c, struct poro_error *err);
+void sim_destroy(struct sim **s);
+
+/* Advances one time step dt. On failure the error is in sim_error(s) and the state is the one at
+ * the failure (for the message; not meant to be continued). */
+enum poro_status sim_step(struct sim *s);
+int sim_done(const struct sim *s);               /* time has reached the case's end time */
+double sim_time(const struct sim *s);
+long sim_steps_taken(const struct sim *s);
+long sim_steps_total(const struct sim *s);
+const struct poro_error *sim_error(const struct sim *s);
+
+/* Point sets. The water set is the double-point water points, or for single point the water
+ * phase riding on the soil points (positions shared with the soil set). */
+const struct particles *sim_soil(const struct sim *s);
+const struct particles *sim_water(const struct sim *s);
+int sim_is_double_point(const struct sim *s);
+
+/* Physical pore pressure (positive in compression, Pa) at the points that carry it: the water
+ * points in double point, the soil points in single point. Writes sim_pressure_point_count(s)
+ * values and their positions (2 per point) if positions is not NULL. */
+idx_t sim_pressure_point_count(const struct sim *s);
+void sim_pore_pressure(const struct sim *s, double *pressure, double *positions);
+
+/* Totals for conservation checks, kg per m: soil sum (1 - n) rho_s V over soil points; water
+ * sum n rho_w V over water points (double point; single point: the water in the pores). */
+double sim_soil_mass(const struct sim *s);
+double sim_water_mass(const struct sim *s);
+/* Sum of nodal soil and water-point masses after the last P2G (partition of unity check). */
+void sim_grid_masses(const struct sim *s, double *soil, double *water_points);
+
+/* Value of probe i of the case at the current state (units: Pa, m). */
+double sim_probe_value(const struct sim *s, int i);
+
+/* Progress report given to sim_run's callback after steps; wall_seconds since the run started. */
+struct sim_progress {
+	long step, steps_total;
+	double time, end_time, wall_seconds;
+	double us_per_point_step;        /* wall microseconds per material-point step so far */
+};
+typedef void (*sim_progress_fn)(const struct sim_progress *p, void *user);
+
+/* Runs to the end time writing out_dir/result.h5 and result.xdmf (frames at the case's
+ * frame_interval, probes every step); calls progress every progress_interval of wall time and
+ * at the end. stop (may be NULL) is polled each step: non-zero interrupts with PORO_EINTERRUPTED. */
+enum poro_status sim_run(struct sim *s, const char *out_dir, const char *solver_version,
+			 sim_progress_fn progress, void *user, volatile int *stop);
+
+#endif

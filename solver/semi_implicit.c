@@ -1,0 +1,313 @@
+/*
+ * semi_implicit.c - the semi-implicit incremental fractional-step scheme of paper 000 (§3-4),
+ * double-point and single-point, one step = the ten steps of the algorithm in §4.5.
+ *
+ * Symbols (000 §4.2): M_s, M_w nodal soil and water masses; n_I, k_I nodal porosity and
+ * conductivity; v^t, v*, v^{t+1} nodal velocities; Q_I the drag coefficient (Eq. 58); dp the nodal
+ * pore-pressure increment. Pressure is tension positive inside the solver, as in the paper.
+ *
+ * Choices the paper leaves open, each explained where it is made:
+ *  - the water points' porosity and volume (steps 8h-8i) are projected at the start of the next
+ *    step, from the soil porosity mapped in step 2c, so they use the points' current positions;
+ *  - the water velocity (Eq. 51) is mass weighted with the water points' own masses, which equals
+ *    the paper's rho_w V0 weighting whenever the initial porosity is uniform;
+ *  - step 7c needs the nodal p^t_I, which the paper defines only as the inner sum of Eq. 77
+ *    (the water-mass-weighted projection of the point pressures). With it, step 7c already is the
+ *    node-wise mapping and remapping of Eq. 77 applied to p^t + dp, and the point pressures it
+ *    yields are the smoothed ones the forces of Eqs. 55 and 57 use (§4.4.1). Step 9a is therefore
+ *    not applied a second time. We measured the alternatives on the Terzaghi column
+ *    (docs/numerics.md): applying Eq. 77 again after 7c makes the pressure grow without bound
+ *    within 400 steps; keeping unsmoothed point pressures (p += sum S dp) and smoothing only for
+ *    the forces leaves a mode the forces cannot see, which grows at k = 1e-9 m/s. With smoothing
+ *    switched off the points keep their pressure and add the interpolated increment;
+ *  - in the Laplacian L (Eq. 61) the porosity stays inside the point sum so that L is symmetric
+ *    (see pressure.c).
+ * Single point: the water set rides on the soil points (same positions, volumes, porosity), so
+ * every formula below serves both variants; only the water points' own motion differs.
+ */
+#include <math.h>
+#include <string.h>
+
+#include "shape.h"
+#include "sim_internal.h"
+#include "transfer.h"
+
+#define TRY(call)                                       \
+	do {                                            \
+		enum poro_status st_ = (call);          \
+		if (st_ != PORO_OK)                     \
+			return st_;                     \
+	} while (0)
+
+/* Step 1: shape functions and gradients of soil and (double point) water points. */
+static enum poro_status evaluate_shape_functions(struct sim *s)
+{
+	enum case_shape kind = s->spec->formulation.shape;
+	TRY(shape_evaluate(&s->grid, kind, &s->soil, "soil", &s->err));
+	if (s->double_point)
+		TRY(shape_evaluate(&s->grid, kind, &s->water, "water", &s->err));
+	return PORO_OK;
+}
+
+static void reset_grid(struct sim *s)
+{
+	const size_t n = (size_t)s->grid.node_count;
+	struct grid_fields *f = &s->f;
+	double *scalars[] = {f->mass_s, f->mass_w, f->mass_w_points, f->mass_w_v, f->porosity,
+			     f->conductivity, f->pressure, f->dp, f->rhs};
+	double *vectors[] = {f->v_s, f->v_w, f->v_s_old, f->v_w_old, f->v_s_star, f->v_w_star,
+			     f->force_w, f->force, f->correction_s, f->correction_w, f->du_s};
+	for (size_t i = 0; i < sizeof scalars / sizeof *scalars; i++)
+		memset(scalars[i], 0, n * sizeof(double));
+	for (size_t i = 0; i < sizeof vectors / sizeof *vectors; i++)
+		memset(vectors[i], 0, 2 * n * sizeof(double));
+}
+
+/* Divides a nodal field (width 1 or 2) by a nodal weight where the weight is positive. */
+static void normalise(idx_t nodes, double *field, int width, const double *weight)
+{
+	for (idx_t I = 0; I < nodes; I++)
+		for (int c = 0; c < width; c++)
+			field[width * I + c] = weight[I] > 0.0 ? field[width * I + c] / weight[I] : 0.0;
+}
+
+/* Step 2a-d: soil mass (Eq. 44), velocity (Eq. 45), porosity (Eq. 46), conductivity (Eq. 47). */
+static void map_soil_to_grid(struct sim *s)
+{
+	const struct particles *p = &s->soil;
+	struct grid_fields *f = &s->f;
+	p2g_scalar(&s->grid, p, NULL, p->mass, f->mass_s);
+	p2g_vector(&s->grid, p, p->mass, p->v, f->v_s);
+	p2g_scalar(&s->grid, p, p->mass, p->porosity, f->porosity);
+	p2g_scalar(&s->grid, p, p->mass, p->conductivity, f->conductivity);
+	idx_t nodes = s->grid.node_count;
+	normalise(nodes, f->v_s, 2, f->mass_s);
+	normalise(nodes, f->conductivity, 1, f->mass_s);
+	for (idx_t I = 0; I < nodes; I++)   /* where there is no soil the pores are all water */
+		f->porosity[I] = f->mass_s[I] > 0.0 ? f->porosity[I] / f->mass_s[I] : 1.0;
+	memcpy(f->v_s_old, f->v_s, 2 * sizeof(double) * (size_t)nodes);
+}
+
+/* Steps 8h-8i, done at the start of the step from the nodal porosity just mapped: the soil
+ * porosity seen by each water point (Eq. 48) and its volume V_wp = n0 / n V0 (Eq. 36). Double
+ * point only: single-point water shares the soil points' porosity and volume. */
+static void project_porosity_to_water(struct sim *s)
+{
+	struct particles *w = &s->water;
+	if (!s->double_point)
+		return;
+	g2p_scalar(&s->grid, w, s->f.porosity, w->porosity);
+	for (idx_t q = 0; q < w->n; q++)
+		w->volume[q] = w->porosity0[q] / w->porosity[q] * w->volume0[q];
+}
+
+/* Step 2e-f: water mass (Eq. 50), water velocity (Eq. 51) and the nodal pressure p^t. */
+static void map_water_to_grid(struct sim *s)
+{
+	struct particles *w = &s->water;
+	struct grid_fields *f = &s->f;
+	const idx_t nodes = s->grid.node_count;
+	for (idx_t q = 0; q < w->n; q++)    /* n rho_w V: constant n0 rho_w V0 in double point (Eq. 37) */
+		w->mass[q] = w->porosity[q] * s->rho_w * w->volume[q];
+	p2g_scalar(&s->grid, w, NULL, w->volume, f->mass_w_v);
+	p2g_scalar(&s->grid, w, NULL, w->mass, f->mass_w_points);
+	p2g_vector(&s->grid, w, w->mass, w->v, f->v_w);
+	p2g_scalar(&s->grid, w, w->mass, w->pressure, f->pressure);
+	normalise(nodes, f->v_w, 2, f->mass_w_points);
+	normalise(nodes, f->pressure, 1, f->mass_w_points);
+	for (idx_t I = 0; I < nodes; I++)   /* Eq. 50: grid porosity times sum S rho_w V_wp */
+		f->mass_w[I] = f->porosity[I] * s->rho_w * f->mass_w_v[I];
+	memcpy(f->v_w_old, f->v_w, 2 * sizeof(double) * (size_t)nodes);
+}
+
+/* Step 3: explicit water predictor, Eq. 53 with Eqs. 56-59, then the water constraints (3e). */
+static void water_predictor(struct sim *s)
+{
+	struct grid_fields *f = &s->f;
+	const struct particles *w = &s->water;
+	const double dt = s->dt;
+	p2g_internal_force(&s->grid, w, w->volume, NULL, w->pressure, f->force_w);
+	for (idx_t I = 0; I < s->grid.node_count; I++) {
+		const double n = f->porosity[I], Mw = f->mass_w[I];
+		if (!(Mw > 0.0))
+			continue;
+		double Q = 0.0;            /* Eq. 58; no drag where there is no soil */
+		if (f->mass_s[I] > 0.0 && f->conductivity[I] > 0.0)
+			Q = CONDUCTIVITY_GRAVITY * n / f->conductivity[I] * Mw;
+		for (int c = 0; c < 2; c++) {
+			/* F_w^ext - F_w^int: Eq. 56 is M_wI b; Eq. 57 carries the nodal porosity */
+			double force = n * f->force_w[2 * I + c] + Mw * s->gravity[c];
+			f->force_w[2 * I + c] = force;
+			f->v_w_star[2 * I + c] = (dt * (force + Q * f->v_s[2 * I + c]) + Mw * f->v_w[2 * I + c]) /
+						 (Mw + Q * dt);   /* Eq. 59: M_w + Q dt */
+		}
+	}
+	boundary_apply(&s->grid, f->fix_w, f->v_w_star);
+}
+
+/* Step 4: explicit soil predictor, Eq. 52 with Eqs. 54-55, then the soil constraints (4d). */
+static void soil_predictor(struct sim *s)
+{
+	struct grid_fields *f = &s->f;
+	const struct particles *p = &s->soil, *w = &s->water;
+	p2g_internal_force(&s->grid, p, p->volume, p->stress, NULL, f->force);
+	p2g_internal_force(&s->grid, w, w->volume, NULL, w->pressure, f->force);
+	loads_add_tractions(s, s->time + s->dt, f->force);
+	for (idx_t I = 0; I < s->grid.node_count; I++) {
+		const double Ms = f->mass_s[I], Mw = f->mass_w[I];
+		if (!(Ms > 0.0))
+			continue;
+		for (int c = 0; c < 2; c++) {
+			/* F^ext = F_w^ext + M_s b + tractions (Eq. 54); F_w^ext = M_w b */
+			double force = f->force[2 * I + c] + (Ms + Mw) * s->gravity[c];
+			f->force[2 * I + c] = force;
+			double dvw = Mw > 0.0 ? f->v_w_star[2 * I + c] - f->v_w[2 * I + c] : 0.0;
+			f->v_s_star[2 * I + c] = (s->dt * force - Mw * dvw) / Ms + f->v_s[2 * I + c];
+		}
+	}
+	boundary_apply(&s->grid, f->fix_s, f->v_s_star);
+}
+
+/* Step 6: velocity correction, Eqs. 64-68. With G = G_s + G_w and Eq. 65 substituted, Eq. 64
+ * reduces to M_s (v_s^{t+1} - v_s*) = dt G_s dp, which is how it is evaluated. */
+static void correct_velocities(struct sim *s)
+{
+	struct grid_fields *f = &s->f;
+	const struct grid *g = &s->grid;
+	double *grad_s = s->soil_grad, *grad_w = s->water_vec;
+	g2p_scalar_gradient(g, &s->soil, f->dp, grad_s);
+	p2g_vector(g, &s->soil, s->soil.volume, grad_s, f->correction_s);
+	g2p_scalar_gradient(g, &s->water, f->dp, grad_w);
+	p2g_vector(g, &s->water, s->water.volume, grad_w, f->correction_w);
+	for (idx_t I = 0; I < g->node_count; I++) {
+		const double n = f->porosity[I];
+		for (int c = 0; c < 2; c++) {
+			const int k = 2 * I + c;
+			f->v_w[k] = f->mass_w[I] > 0.0 ? f->v_w_star[k] + s->dt * n * f->correction_w[k] / f->mass_w[I] : 0.0;
+			f->v_s[k] = f->mass_s[I] > 0.0 ? f->v_s_star[k] + s->dt * (1.0 - n) * f->correction_s[k] / f->mass_s[I] : 0.0;
+		}
+	}
+	boundary_apply(g, f->fix_w, f->v_w);
+	boundary_apply(g, f->fix_s, f->v_s);
+}
+
+/* Step 7a-b for one set: FLIP velocity update blended with PIC by flip_fraction, and the
+ * position update x += dt sum S v^{t+1}. v_old is overwritten with the nodal increment. */
+static void move_points(struct sim *s, struct particles *p, const double *v_new, double *v_old,
+			double *scratch, int move_positions)
+{
+	const double alpha = s->spec->formulation.flip_fraction;
+	for (idx_t I = 0; I < 2 * s->grid.node_count; I++)
+		v_old[I] = v_new[I] - v_old[I];
+	double *v_pic = scratch, *dv = scratch + 2 * (size_t)p->n;
+	g2p_vector(&s->grid, p, v_new, v_pic);
+	g2p_vector(&s->grid, p, v_old, dv);
+	for (idx_t k = 0; k < 2 * p->n; k++) {
+		p->v[k] = alpha * (p->v[k] + dv[k]) + (1.0 - alpha) * v_pic[k];
+		if (move_positions)
+			p->x[k] += s->dt * v_pic[k];
+	}
+}
+
+/* Step 7: points take velocities, positions and the new pore pressure from the grid. */
+static void update_points(struct sim *s)
+{
+	struct grid_fields *f = &s->f;
+	move_points(s, &s->soil, f->v_s, f->v_s_old, s->soil_grad, 1);
+	move_points(s, &s->water, f->v_w, f->v_w_old, s->water_vec, s->double_point);
+	if (s->spec->formulation.pore_pressure_smoothing) {
+		/* 7c with 9a: p^{t+1}_I = p^t_I + dp_I, p^t_I being the smoothed nodal pressure of
+		 * step 2 (Eq. 77's inner sum), interpolated back to the points (Eq. 77's outer sum) */
+		for (idx_t I = 0; I < s->grid.node_count; I++)
+			f->pressure[I] += f->dp[I];
+		g2p_scalar(&s->grid, &s->water, f->pressure, s->water.pressure);
+	} else {
+		/* unsmoothed: each point keeps its pressure and adds the interpolated increment */
+		g2p_scalar(&s->grid, &s->water, f->dp, s->water_scalar);
+		for (idx_t q = 0; q < s->water.n; q++)
+			s->water.pressure[q] += s->water_scalar[q];
+	}
+}
+
+/* Step 8: MUSL displacement increment (8a), deformation gradient increment (8b-c), volume,
+ * Jacobian and porosity (8d-f), Kozeny-Carman conductivity (8g). */
+static enum poro_status update_soil_kinematics(struct sim *s)
+{
+	struct particles *p = &s->soil;
+	struct grid_fields *f = &s->f;
+	p2g_vector(&s->grid, p, p->mass, p->v, f->du_s);
+	for (idx_t I = 0; I < s->grid.node_count; I++)
+		for (int c = 0; c < 2; c++)
+			f->du_s[2 * I + c] = f->mass_s[I] > 0.0 ? s->dt * f->du_s[2 * I + c] / f->mass_s[I] : 0.0;
+	boundary_apply(&s->grid, f->fix_s, f->du_s);
+	g2p_vector_gradient(&s->grid, p, f->du_s, p->dF);
+	idx_t bad = -1;
+	for (idx_t q = 0; q < p->n; q++) {
+		double *dF = p->dF + 4 * q, *F = p->F + 4 * q;
+		dF[0] += 1.0, dF[3] += 1.0;
+		double dJ = dF[0] * dF[3] - dF[1] * dF[2];
+		double F0 = dF[0] * F[0] + dF[1] * F[2], F1 = dF[0] * F[1] + dF[1] * F[3];
+		double F2 = dF[2] * F[0] + dF[3] * F[2], F3 = dF[2] * F[1] + dF[3] * F[3];
+		F[0] = F0, F[1] = F1, F[2] = F2, F[3] = F3;
+		p->volume[q] *= dJ;
+		double J = p->volume[q] / p->volume0[q];
+		double n = 1.0 - (1.0 - p->porosity0[q]) / J;
+		if (!(dJ > 0.0) || !(n > 0.0 && n < 1.0)) {
+			bad = q;
+			break;
+		}
+		p->porosity[q] = n;
+		const struct case_body *body = &s->spec->bodies[p->body[q]];
+		if (body->permeability_law == PERMEABILITY_KOZENY_CARMAN) {
+			double n0 = p->porosity0[q];
+			double C1 = body->hydraulic_conductivity * (1.0 - n0) * (1.0 - n0) / (n0 * n0 * n0);
+			p->conductivity[q] = C1 * n * n * n / ((1.0 - n) * (1.0 - n));
+		}
+	}
+	if (bad >= 0)
+		return poro_error_set(&s->err, PORO_ESOLVER, "soil point %ld at (%.6g, %.6g) m: volume ratio %.6g "
+				      "gives porosity outside (0, 1) or an inverted point at step %ld",
+				      (long)bad, p->x[2 * bad], p->x[2 * bad + 1], p->volume[bad] / p->volume0[bad],
+				      s->step + 1);
+	return PORO_OK;
+}
+
+/* Step 10: stress update through the material interface (Eqs. 69-76). */
+static enum poro_status update_stress(struct sim *s)
+{
+	struct particles *p = &s->soil;
+	enum poro_status status = PORO_OK;
+	for (idx_t q = 0; q < p->n && status == PORO_OK; q++) {
+		struct stress_update u = {
+			.dF = p->dF + 4 * q,
+			.J = p->volume[q] / p->volume0[q],
+			.stress = p->stress + 4 * q,
+			.Be = p->Be + 4 * q,
+			.state = p->state + STATE_MAX * q,
+			.plastic_strain = p->plastic_strain + q,
+		};
+		const struct material *m = &s->materials[s->spec->bodies[p->body[q]].material];
+		status = material_update(m, &u, &s->err);
+	}
+	return status;
+}
+
+enum poro_status semi_implicit_step(struct sim *s)
+{
+	loads_gravity(s->spec, s->time + s->dt, s->gravity);   /* b^{t+1} */
+	TRY(evaluate_shape_functions(s));                       /* (1) */
+	reset_grid(s);
+	map_soil_to_grid(s);                                    /* (2a-d) */
+	project_porosity_to_water(s);                           /* (8h-i) of the last step */
+	map_water_to_grid(s);                                   /* (2e-f) */
+	water_predictor(s);                                     /* (3) Eq. 53 */
+	soil_predictor(s);                                      /* (4) Eq. 52 */
+	TRY(pressure_solve(s));                                 /* (5) Eq. 60 */
+	correct_velocities(s);                                  /* (6) Eqs. 64-65 */
+	update_points(s);                                       /* (7) */
+	TRY(update_soil_kinematics(s));                         /* (8) */
+	TRY(update_stress(s));                                  /* (10) */
+	s->time = (double)(s->step + 1) * s->dt;   /* no drift from summing dt */
+	s->step++;
+	return PORO_OK;
+}

@@ -1,0 +1,101 @@
+/*
+ * shape.c - linear and quadratic B-spline shape functions (see shape.h for the edge treatment).
+ *
+ * Local symbols: xi = (x - origin) / h, the coordinate in cells; d = xi - node, the signed distance
+ * to a node in cells. Weights are dimensionless, gradients are per metre (multiplied by 1/h).
+ */
+#include "shape.h"
+
+#include <math.h>
+
+int shape_support(enum case_shape kind)
+{
+	return kind == SHAPE_LINEAR ? 2 : 3;
+}
+
+static int linear_1d(double xi, idx_t cells, double inv_h, idx_t *i0, double *w, double *dw)
+{
+	idx_t i = (idx_t)floor(xi);
+	if (i == cells)
+		i = cells - 1;          /* a point exactly on the last node belongs to the last cell */
+	double f = xi - i;
+	*i0 = i;
+	w[0] = 1.0 - f;
+	w[1] = f;
+	dw[0] = -inv_h;
+	dw[1] = inv_h;
+	return 0;
+}
+
+static int quadratic_1d(double xi, idx_t cells, double inv_h, idx_t *i0, double *w, double *dw)
+{
+	if (xi < 0.5) {                 /* half cell at the lower edge: modified, interpolating */
+		*i0 = 0;
+		w[0] = 1.0 - xi, w[1] = xi, w[2] = 0.0;
+		dw[0] = -inv_h, dw[1] = inv_h, dw[2] = 0.0;
+		return 0;
+	}
+	if (xi >= cells - 0.5) {        /* half cell at the upper edge, mirrored; xi = cells - 1/2 lands here
+					   so that no support node lies beyond the edge */
+		double s = cells - xi;
+		*i0 = cells - 2;
+		w[0] = 0.0, w[1] = s, w[2] = 1.0 - s;
+		dw[0] = 0.0, dw[1] = -inv_h, dw[2] = inv_h;
+		return 0;
+	}
+	idx_t i = (idx_t)floor(xi + 0.5) - 1;   /* nearest node minus one */
+	double d0 = xi - i, d1 = d0 - 1.0, d2 = d0 - 2.0;   /* d0 in [1/2, 3/2) */
+	*i0 = i;
+	w[0] = 0.5 * (1.5 - d0) * (1.5 - d0);
+	w[1] = 0.75 - d1 * d1;
+	w[2] = 0.5 * (1.5 + d2) * (1.5 + d2);
+	dw[0] = -(1.5 - d0) * inv_h;
+	dw[1] = -2.0 * d1 * inv_h;
+	dw[2] = (1.5 + d2) * inv_h;
+	return 0;
+}
+
+int shape_1d(enum case_shape kind, double xi, idx_t cells, double inv_h, idx_t *i0, double *w, double *dw)
+{
+	if (!(xi >= 0.0 && xi <= (double)cells))
+		return -1;
+	if (kind == SHAPE_LINEAR)
+		return linear_1d(xi, cells, inv_h, i0, w, dw);
+	return quadratic_1d(xi, cells, inv_h, i0, w, dw);
+}
+
+enum poro_status shape_evaluate(const struct grid *g, enum case_shape kind, struct particles *p,
+				const char *set_name, struct poro_error *err)
+{
+	const int S = shape_support(kind), nn = S * S;
+	idx_t bad = -1;
+	p->support = S;
+#pragma omp parallel for schedule(static)
+	for (idx_t q = 0; q < p->n; q++) {
+		double wx[SHAPE_SUPPORT_MAX], wy[SHAPE_SUPPORT_MAX], dx[SHAPE_SUPPORT_MAX], dy[SHAPE_SUPPORT_MAX];
+		idx_t i0 = 0, j0 = 0;
+		double xi = (p->x[2 * q] - g->origin[0]) * g->inv_h;
+		double eta = (p->x[2 * q + 1] - g->origin[1]) * g->inv_h;
+		if (shape_1d(kind, xi, g->cells[0], g->inv_h, &i0, wx, dx) ||
+		    shape_1d(kind, eta, g->cells[1], g->inv_h, &j0, wy, dy)) {
+#pragma omp critical
+			if (bad < 0 || q < bad)
+				bad = q;
+			continue;
+		}
+		p->node0[q] = grid_node(g, i0, j0);
+		double *w = p->w + (size_t)q * nn, *dw = p->dw + (size_t)q * 2 * nn;
+		for (int b = 0; b < S; b++)
+			for (int a = 0; a < S; a++) {
+				int k = a + b * S;
+				w[k] = wx[a] * wy[b];
+				dw[2 * k] = dx[a] * wy[b];
+				dw[2 * k + 1] = wx[a] * dy[b];
+			}
+	}
+	if (bad >= 0)
+		return poro_error_set(err, PORO_ESOLVER,
+				      "%s point %ld left the grid at (%.6g, %.6g) m", set_name, (long)bad,
+				      p->x[2 * bad], p->x[2 * bad + 1]);
+	return PORO_OK;
+}

@@ -1,0 +1,33 @@
+/*
+ * shape.h - shape functions S_Ip and gradients for a point's support nodes (000 §4.5 step 1).
+ *
+ * Kinds: linear (tent, 2x2 nodes) and quadratic B-spline (3x3 nodes, Steffen et al. 2008 style,
+ * node-centred). Both are tensor products of 1-D functions.
+ *
+ * Quadratic B-spline at the grid edges: the standard node-centred basis would need a ghost node
+ * beyond the edge. We instead modify the half cell next to an edge so that the basis keeps the
+ * partition of unity and is interpolating at the edge (S_edge = 1 there), which makes a velocity
+ * constraint on edge nodes an exact wall condition. In local coordinate s in [0, 1/2] measured
+ * from the edge (in cells), the edge node's function is 1 - s and its neighbour's s; elsewhere the
+ * standard pieces apply. Matching value and slope at s = 1/2 with the standard pieces
+ * (1/2 (3/2 - s)^2 and 3/4 - (s - 1)^2) shows the modified basis is still C1 and non-negative.
+ */
+#ifndef PORO_SHAPE_H
+#define PORO_SHAPE_H
+
+#include "grid.h"
+
+/* Support nodes per direction for a shape kind. */
+int shape_support(enum case_shape kind);
+
+/* 1-D weights and derivatives (per metre) for coordinate xi (in cells from the grid origin) on a
+ * grid of `cells` cells. Writes the first support node to *i0 and support() values to w, dw.
+ * Returns 0, or -1 if xi lies outside [0, cells]. */
+int shape_1d(enum case_shape kind, double xi, idx_t cells, double inv_h, idx_t *i0, double *w, double *dw);
+
+/* Fills p->node0, p->w, p->dw for every point (the shape cache). Returns PORO_ESOLVER naming the
+ * first point found outside the grid. */
+enum poro_status shape_evaluate(const struct grid *g, enum case_shape kind, struct particles *p,
+				const char *set_name, struct poro_error *err);
+
+#endif

@@ -1,0 +1,265 @@
+/*
+ * sim.c - building a simulation from a case: grid, material points, materials, workspaces;
+ * stepping and the read-only accessors of poro.h.
+ *
+ * Material points are seeded on a regular sub-grid: particles_per_cell^2 points per cell at the
+ * centres of equal sub-cells, kept when inside the body (a point already inside an earlier body
+ * belongs to that one). Each point gets the volume of its sub-cell. Double point seeds one water
+ * point on every soil point (000 §5.1: "640 material points in total for both water and soil").
+ */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "sim_internal.h"
+
+static int inside_polygon(const struct case_body *b, double x, double y)
+{
+	int inside = 0;
+	for (int i = 0, j = b->polygon_count - 1; i < b->polygon_count; j = i++) {
+		const double *pi = b->polygon[i], *pj = b->polygon[j];
+		if ((pi[1] > y) != (pj[1] > y) && x < (pj[0] - pi[0]) * (y - pi[1]) / (pj[1] - pi[1]) + pi[0])
+			inside = !inside;
+	}
+	return inside;
+}
+
+static int inside_body(const struct case_body *b, double x, double y)
+{
+	if (x < b->min[0] || x > b->max[0] || y < b->min[1] || y > b->max[1])
+		return 0;
+	return b->is_polygon ? inside_polygon(b, x, y) : 1;
+}
+
+/* Visits every seed point: fills p when it is not NULL; returns the count. */
+static idx_t seed_points(const struct sim *s, struct particles *p)
+{
+	const struct case_spec *c = s->spec;
+	const struct grid *g = &s->grid;
+	idx_t count = 0;
+	for (int b = 0; b < c->body_count; b++) {
+		const struct case_body *body = &c->bodies[b];
+		const int ppc = body->particles_per_cell;
+		const double d = g->h / ppc;
+		for (idx_t cj = 0; cj < g->cells[1]; cj++)
+			for (idx_t ci = 0; ci < g->cells[0]; ci++)
+				for (int sj = 0; sj < ppc; sj++)
+					for (int si = 0; si < ppc; si++) {
+						double x = g->origin[0] + ci * g->h + (si + 0.5) * d;
+						double y = g->origin[1] + cj * g->h + (sj + 0.5) * d;
+						if (!inside_body(body, x, y))
+							continue;
+						int taken = 0;
+						for (int e = 0; e < b && !taken; e++)
+							taken = inside_body(&c->bodies[e], x, y);
+						if (taken)
+							continue;
+						if (p) {
+							p->x[2 * count] = p->x0[2 * count] = x;
+							p->x[2 * count + 1] = p->x0[2 * count + 1] = y;
+							p->volume[count] = p->volume0[count] = d * d;
+							p->body[count] = b;
+						}
+						count++;
+					}
+	}
+	return count;
+}
+
+static void init_soil_state(struct sim *s)
+{
+	struct particles *p = &s->soil;
+	for (idx_t q = 0; q < p->n; q++) {
+		const struct case_body *body = &s->spec->bodies[p->body[q]];
+		const struct material *m = &s->materials[body->material];
+		p->porosity[q] = p->porosity0[q] = body->porosity;
+		p->conductivity[q] = body->hydraulic_conductivity;
+		p->mass[q] = (1.0 - body->porosity) * m->density * p->volume0[q];   /* Eq. 33 */
+		double *F = p->F + 4 * q;
+		F[0] = F[3] = 1.0;
+		material_init_state(m, p->stress + 4 * q, p->Be + 4 * q, p->state + STATE_MAX * q);
+	}
+}
+
+static enum poro_status init_water(struct sim *s)
+{
+	struct particles *p = &s->soil, *w = &s->water;
+	if (!s->double_point) {
+		enum poro_status st = particles_init_alias(w, p, &s->err);
+		if (st)
+			return st;
+	} else {
+		enum poro_status st = particles_init(w, p->n, 0, &s->err);
+		if (st)
+			return st;
+		memcpy(w->x, p->x, sizeof(double) * 2 * (size_t)p->n);
+		memcpy(w->x0, p->x0, sizeof(double) * 2 * (size_t)p->n);
+		memcpy(w->volume, p->volume, sizeof(double) * (size_t)p->n);
+		memcpy(w->volume0, p->volume0, sizeof(double) * (size_t)p->n);
+		memcpy(w->porosity, p->porosity, sizeof(double) * (size_t)p->n);
+		memcpy(w->porosity0, p->porosity0, sizeof(double) * (size_t)p->n);
+		memcpy(w->conductivity, p->conductivity, sizeof(double) * (size_t)p->n);
+		memcpy(w->body, p->body, sizeof(int) * (size_t)p->n);
+	}
+	w->support = p->support;
+	for (idx_t q = 0; q < w->n; q++)
+		w->mass[q] = w->porosity0[q] * s->rho_w * w->volume0[q];   /* Eq. 37 */
+	return PORO_OK;
+}
+
+static enum poro_status allocate_scratch(struct sim *s)
+{
+	size_t ns = (size_t)s->soil.n + 1, nw = (size_t)s->water.n + 1;
+	s->soil_grad = calloc(4 * ns, sizeof(double));
+	s->soil_scalar = calloc(ns, sizeof(double));
+	s->soil_coef = calloc(ns, sizeof(double));
+	s->water_vec = calloc(4 * nw, sizeof(double));
+	s->water_scalar = calloc(nw, sizeof(double));
+	s->water_coef = calloc(nw, sizeof(double));
+	s->probe_point = calloc((size_t)s->spec->probe_count + 1, sizeof(int));
+	if (!s->soil_grad || !s->soil_scalar || !s->soil_coef || !s->water_vec || !s->water_scalar ||
+	    !s->water_coef || !s->probe_point)
+		return poro_error_set(&s->err, PORO_ENOMEM, "cannot allocate step workspaces");
+	return PORO_OK;
+}
+
+static enum poro_status build(struct sim *s)
+{
+	const struct case_spec *c = s->spec;
+	enum poro_status st;
+	if ((st = grid_init(&s->grid, &c->grid, &s->err)) || (st = grid_fields_init(&s->f, &s->grid, &s->err)))
+		return st;
+	s->materials = calloc((size_t)c->material_count, sizeof *s->materials);
+	if (!s->materials)
+		return poro_error_set(&s->err, PORO_ENOMEM, "cannot allocate materials");
+	for (int m = 0; m < c->material_count; m++)
+		material_init(&s->materials[m], &c->materials[m]);
+	idx_t n = seed_points(s, NULL);
+	if (n == 0)
+		return poro_error_set(&s->err, PORO_EINVAL, "/bodies: no material point falls inside any body");
+	if ((st = particles_init(&s->soil, n, 1, &s->err)))
+		return st;
+	seed_points(s, &s->soil);
+	s->soil.support = c->formulation.shape == SHAPE_LINEAR ? 2 : 3;
+	init_soil_state(s);
+	if ((st = init_water(s)) || (st = allocate_scratch(s)))
+		return st;
+	if ((st = pressure_system_init(&s->ps, &s->grid, s->soil.support, &s->err)))
+		return st;
+	boundary_mark(s);
+	loads_init(s);
+	probes_init(s);
+	return PORO_OK;
+}
+
+enum poro_status sim_create(struct sim **out, const struct case_spec *c, struct poro_error *err)
+{
+	*out = NULL;
+	struct sim *s = calloc(1, sizeof *s);
+	if (!s)
+		return poro_error_set(err, PORO_ENOMEM, "cannot allocate a simulation");
+	s->spec = c;
+	s->double_point = c->formulation.phases == PHASES_DOUBLE_POINT;
+	s->dt = c->time.dt;
+	s->steps_total = (long)ceil(c->time.end / c->time.dt - 1e-9);
+	s->rho_w = c->fluid.density;
+	enum poro_status st = build(s);
+	if (st) {
+		if (err)
+			*err = s->err;
+		sim_destroy(&s);
+		return st;
+	}
+	*out = s;
+	return PORO_OK;
+}
+
+void sim_destroy(struct sim **ps)
+{
+	struct sim *s = ps ? *ps : NULL;
+	if (!s)
+		return;
+	particles_release(&s->water);
+	particles_release(&s->soil);
+	grid_fields_release(&s->f);
+	pressure_system_release(&s->ps);
+	free(s->materials);
+	free(s->soil_grad);
+	free(s->soil_scalar);
+	free(s->soil_coef);
+	free(s->water_vec);
+	free(s->water_scalar);
+	free(s->water_coef);
+	free(s->probe_point);
+	free(s);
+	*ps = NULL;
+}
+
+enum poro_status sim_step(struct sim *s)
+{
+	enum poro_status st = semi_implicit_step(s);
+	if (st)
+		return st;
+	const struct particles *p = &s->soil;
+	for (idx_t q = 0; q < p->n; q++)      /* NaN anywhere in a step surfaces in these */
+		if (!isfinite(p->v[2 * q] + p->v[2 * q + 1] + p->stress[4 * q] + p->stress[4 * q + 1] + p->stress[4 * q + 2]))
+			return poro_error_set(&s->err, PORO_ESOLVER, "soil point %ld at (%.6g, %.6g) m has a "
+					      "non-finite velocity or stress at step %ld (t = %.6g s)", (long)q,
+					      p->x[2 * q], p->x[2 * q + 1], s->step, s->time);
+	for (idx_t q = 0; q < s->water.n; q++)
+		if (!isfinite(s->water.pressure[q] + s->water.v[2 * q] + s->water.v[2 * q + 1]))
+			return poro_error_set(&s->err, PORO_ESOLVER, "water point %ld at (%.6g, %.6g) m has a "
+					      "non-finite pressure or velocity at step %ld (t = %.6g s)", (long)q,
+					      s->water.x[2 * q], s->water.x[2 * q + 1], s->step, s->time);
+	return PORO_OK;
+}
+
+int sim_done(const struct sim *s) { return s->step >= s->steps_total; }
+double sim_time(const struct sim *s) { return s->time; }
+long sim_steps_taken(const struct sim *s) { return s->step; }
+long sim_steps_total(const struct sim *s) { return s->steps_total; }
+const struct poro_error *sim_error(const struct sim *s) { return &s->err; }
+const struct particles *sim_soil(const struct sim *s) { return &s->soil; }
+const struct particles *sim_water(const struct sim *s) { return &s->water; }
+int sim_is_double_point(const struct sim *s) { return s->double_point; }
+idx_t sim_pressure_point_count(const struct sim *s) { return s->water.n; }
+
+void sim_pore_pressure(const struct sim *s, double *pressure, double *positions)
+{
+	for (idx_t q = 0; q < s->water.n; q++) {
+		pressure[q] = -s->water.pressure[q];    /* physical sign: positive in compression */
+		if (positions) {
+			positions[2 * q] = s->water.x[2 * q];
+			positions[2 * q + 1] = s->water.x[2 * q + 1];
+		}
+	}
+}
+
+double sim_soil_mass(const struct sim *s)
+{
+	const struct particles *p = &s->soil;
+	double m = 0.0;
+	for (idx_t q = 0; q < p->n; q++)
+		m += (1.0 - p->porosity[q]) * s->materials[s->spec->bodies[p->body[q]].material].density * p->volume[q];
+	return m;
+}
+
+double sim_water_mass(const struct sim *s)
+{
+	const struct particles *w = &s->water;
+	double m = 0.0;
+	for (idx_t q = 0; q < w->n; q++)
+		m += w->porosity[q] * s->rho_w * w->volume[q];
+	return m;
+}
+
+void sim_grid_masses(const struct sim *s, double *soil, double *water_points)
+{
+	double ms = 0.0, mw = 0.0;
+	for (idx_t I = 0; I < s->grid.node_count; I++) {
+		ms += s->f.mass_s[I];
+		mw += s->f.mass_w_points[I];
+	}
+	*soil = ms;
+	*water_points = mw;
+}

@@ -1,0 +1,78 @@
+/*
+ * sim_internal.h - the simulation object shared by the solver's internal files (not public).
+ *
+ * struct sim owns the grid, the point sets, the materials and every scratch array a step uses;
+ * all are allocated in sim_create() (STYLE rule 3). Phase functions of the schemes take a
+ * struct sim * and loop over points or nodes.
+ */
+#ifndef PORO_SIM_INTERNAL_H
+#define PORO_SIM_INTERNAL_H
+
+#include "grid.h"
+#include "material.h"
+#include "poro.h"
+#include "spd_solve.h"
+
+/* Standard gravity in the drag term n^2 rho_w g / k (000 Eq. 15): hydraulic conductivity is
+ * defined with it, so it stays 9.81 m/s^2 even when a case switches the body force off. */
+#define CONDUCTIVITY_GRAVITY 9.81
+
+/* The pressure Poisson system (000 Eqs. 60-61) on a fixed (2S-1)^2 node stencil. */
+struct pressure_system {
+	int radius;               /* S - 1: coupling reach in nodes */
+	int width;                /* 2 radius + 1 */
+	double *stencil;          /* [node_count * width^2] L_IJ by offset of J from I */
+	idx_t *unknown;           /* [node_count] unknown number of a node, -1 if not an unknown */
+	idx_t *colptr, *rowidx;   /* CSC upper triangle of the reduced system */
+	double *values, *b, *x;
+	struct spd_solver *solver;
+};
+
+struct sim {
+	const struct case_spec *spec;
+	struct grid grid;
+	struct grid_fields f;
+	struct particles soil, water;
+	int double_point;
+	struct material *materials;   /* [case material_count] */
+	struct pressure_system ps;
+	double dt, time;
+	long step, steps_total;
+	double rho_w;                 /* fluid density, kg/m^3 */
+	double gravity[2];            /* body force b^{t+1} of the current step, m/s^2 */
+
+	/* per-point scratch, sized at create */
+	double *soil_grad;            /* [4 n_soil] velocity or displacement gradient */
+	double *soil_scalar;          /* [n_soil] */
+	double *soil_coef;            /* [n_soil] */
+	double *water_vec;            /* [4 n_water]: two 2-vectors */
+	double *water_scalar;         /* [n_water] */
+	double *water_coef;           /* [n_water] */
+
+	int *probe_point;             /* [probe_count] tracked point of point probes, -1 otherwise */
+	struct poro_error err;
+};
+
+/* semi_implicit.c: one step of 000 §4.5. */
+enum poro_status semi_implicit_step(struct sim *s);
+
+/* pressure.c: free-surface detection and the Poisson solve (000 §4.5 step 5). */
+enum poro_status pressure_system_init(struct pressure_system *ps, const struct grid *g, int support,
+				      struct poro_error *err);
+void pressure_system_release(struct pressure_system *ps);
+void pressure_mark_dirichlet(struct sim *s);
+enum poro_status pressure_solve(struct sim *s);
+
+/* boundary.c: velocity constraints of the grid faces (000 §4.5 steps 3e, 4d, 6d). */
+void boundary_mark(struct sim *s);
+void boundary_apply(const struct grid *g, const unsigned char *fix, double *v);
+
+/* loads.c: tractions on body faces (000 Eq. 54) and gravity with its ramp. */
+void loads_init(struct sim *s);
+void loads_add_tractions(struct sim *s, double time, double *force);
+void loads_gravity(const struct case_spec *c, double time, double b[2]);
+
+/* probes.c */
+void probes_init(struct sim *s);
+
+#endif

@@ -1,0 +1,45 @@
+/*
+ * transfer.h - particle-to-grid (P2G) and grid-to-particle (G2P) kernels shared by every scheme.
+ *
+ * Each kernel is one loop over the points of a set, using the shape cache filled by
+ * shape_evaluate() (node0, w, dw). Scatters ADD into their nodal output (the caller zeroes it);
+ * gathers OVERWRITE their per-point output. A NULL per-point weight or value array means 1.
+ *
+ * Nodal vectors and per-point vectors are interleaved (x, y). Per-point 2x2 tensors are row-major
+ * (xx, xy, yx, yy). Stresses are (xx, yy, xy, zz).
+ */
+#ifndef PORO_TRANSFER_H
+#define PORO_TRANSFER_H
+
+#include "grid.h"
+
+/* out_I += sum_p S_Ip weight_p value_p  (mass, Eq. 44; porosity numerator, Eq. 46; ...). */
+void p2g_scalar(const struct grid *g, const struct particles *p, const double *weight,
+		const double *value, double *out);
+
+/* out_I += sum_p S_Ip weight_p value_p for a 2-vector value (momentum, Eq. 45; ...). */
+void p2g_vector(const struct grid *g, const struct particles *p, const double *weight,
+		const double *value, double *out);
+
+/* out_I -= sum_p weight_p (stress_p + iso_p I) . grad S_Ip: the internal force of Eqs. 55 and 57.
+ * stress (4 per point) or iso (1 per point) may be NULL. */
+void p2g_internal_force(const struct grid *g, const struct particles *p, const double *weight,
+			const double *stress, const double *iso, double *out);
+
+/* out_p = sum_I S_Ip node_I (Eqs. 38-40, 48). */
+void g2p_scalar(const struct grid *g, const struct particles *p, const double *node, double *out);
+
+/* out_p = sum_I S_Ip node_I for a nodal 2-vector. */
+void g2p_vector(const struct grid *g, const struct particles *p, const double *node, double *out);
+
+/* out_p = sum_I node_I grad S_Ip: gradient of a nodal scalar, 2 per point. */
+void g2p_scalar_gradient(const struct grid *g, const struct particles *p, const double *node, double *out);
+
+/* out_p = sum_I node_I (x) grad S_Ip: gradient of a nodal 2-vector, 4 per point, row-major
+ * (d u_x/dx, d u_x/dy, d u_y/dx, d u_y/dy); step 8b uses it for the deformation gradient. */
+void g2p_vector_gradient(const struct grid *g, const struct particles *p, const double *node, double *out);
+
+/* out_p = div of a nodal 2-vector at each point. */
+void g2p_divergence(const struct grid *g, const struct particles *p, const double *node, double *out);
+
+#endif

@@ -1,0 +1,68 @@
+/*
+ * harness.h - the small test harness every C test uses.
+ *
+ * A test program runs named checks; each prints one line, "PASS name" or "FAIL name: why", and
+ * tests/run.sh counts those lines across all programs into the final "N passed, N failed".
+ * CHECK never aborts the program, so one failing check does not hide the others.
+ */
+#ifndef PORO_TEST_HARNESS_H
+#define PORO_TEST_HARNESS_H
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+static int harness_failed_count;
+
+/* Records one named check. */
+#define CHECK(cond, name, ...)                                                    \
+	do {                                                                      \
+		if (cond) {                                                       \
+			printf("PASS %s\n", (name));                              \
+		} else {                                                          \
+			harness_failed_count++;                                   \
+			printf("FAIL %s: ", (name));                              \
+			printf(__VA_ARGS__);                                      \
+			printf("  [%s:%d]\n", __FILE__, __LINE__);                \
+		}                                                                 \
+		fflush(stdout);                                                   \
+	} while (0)
+
+/* Relative difference |a-b| / max(|b|, floor). */
+static inline double rel_diff(double a, double b, double floor)
+{
+	double scale = fabs(b) > floor ? fabs(b) : floor;
+	return fabs(a - b) / scale;
+}
+
+/* Deterministic high-entropy numbers in [lo, hi): xorshift64*, fixed seed per test program. */
+static unsigned long long harness_rng_state = 0x9E3779B97F4A7C15ull;
+static inline double rnd(double lo, double hi)
+{
+	harness_rng_state ^= harness_rng_state >> 12;
+	harness_rng_state ^= harness_rng_state << 25;
+	harness_rng_state ^= harness_rng_state >> 27;
+	unsigned long long r = harness_rng_state * 2685821657736338717ull;
+	return lo + (hi - lo) * (double)(r >> 11) / 9007199254740992.0;
+}
+
+/* A requirement the code does not meet yet, checked and reported but counted as skipped, not
+ * passed: "XFAIL name: measured" while it fails, and "FAIL name: now passes" (an unexpected pass,
+ * so the marker is removed) once it holds. */
+#define CHECK_KNOWN_FAILURE(cond, name, ...)                                      \
+	do {                                                                      \
+		if (cond) {                                                       \
+			harness_failed_count++;                                   \
+			printf("FAIL %s: passes now; make it a CHECK\n", (name)); \
+		} else {                                                          \
+			printf("XFAIL %s: ", (name));                             \
+			printf(__VA_ARGS__);                                      \
+			printf("\n");                                             \
+		}                                                                 \
+		fflush(stdout);                                                   \
+	} while (0)
+
+#define HARNESS_EXIT() return harness_failed_count ? 1 : 0
+
+#endif

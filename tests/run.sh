@@ -1,0 +1,44 @@
+#!/usr/bin/env bash
+# Runs the test programs and prints one closing line "N passed, N failed, N skipped".
+#   tests/run.sh BUILD_DIR test     unit tests, reduced-size verification, command-line tests
+#   tests/run.sh BUILD_DIR verify   paper-size verification runs (tests/verify_full/)
+# Each C test prints PASS/FAIL/XFAIL lines; INFO lines carry the measured figures. The full
+# output is kept in BUILD_DIR/test-output.txt.
+set -u
+build=${1:-build}
+mode=${2:-test}
+cd "$(dirname "$0")/.."
+log="$build/test-output.txt"
+: > "$log"
+
+programs=()
+if [ "$mode" = test ]; then
+	for t in "$build"/tests/solver/*_test "$build"/tests/verify/*_test; do [ -x "$t" ] && programs+=("$t"); done
+	for t in tests/cli/*_test.sh; do [ -f "$t" ] && programs+=("bash $t $build"); done
+else
+	for t in "$build"/tests/verify_full/*_test; do [ -x "$t" ] && programs+=("$t"); done
+fi
+
+crashed=0
+for prog in "${programs[@]}"; do
+	name=${prog##*/}
+	echo "== $name" | tee -a "$log"
+	start=$(date +%s)
+	$prog > "$build/.one-test.txt" 2>&1
+	status=$?
+	cat "$build/.one-test.txt" >> "$log"
+	grep -E '^(FAIL|XFAIL|INFO)' "$build/.one-test.txt"
+	p=$(grep -c '^PASS' "$build/.one-test.txt")
+	f=$(grep -c '^FAIL' "$build/.one-test.txt")
+	echo "   $p passed, $f failed in $(( $(date +%s) - start )) s"
+	if [ "$status" -ne 0 ] && [ "$f" -eq 0 ]; then
+		echo "FAIL $name: exited with status $status without a failed check" | tee -a "$log"
+		crashed=$((crashed + 1))
+	fi
+done
+
+passed=$(grep -c '^PASS' "$log")
+failed=$(( $(grep -c '^FAIL' "$log") ))
+skipped=$(grep -c '^XFAIL' "$log")
+echo "$passed passed, $failed failed, $skipped skipped"
+[ "$failed" -eq 0 ]

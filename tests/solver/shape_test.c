@@ -1,0 +1,120 @@
+/*
+ * shape_test.c - shape functions (issue item g): partition of unity and zero gradient sum at
+ * high-entropy points, including the half cells next to the grid edges; gradients against
+ * central finite differences of the weights; non-negativity; the interpolating edge property.
+ */
+#include "../harness.h"
+#include "shape.h"
+
+#define SAMPLES 20000
+
+static void check_kind(enum case_shape kind, const char *label)
+{
+	const idx_t cells = 7;
+	const double h = 0.0371, inv_h = 1.0 / h;
+	const int S = shape_support(kind);
+	double worst_sum = 0, worst_grad = 0, worst_fd = 0, min_w = 1;
+	int out_of_range = 0;
+	for (int k = 0; k < SAMPLES; k++) {
+		/* one in four samples inside the first or last cell, where the edge pieces live */
+		double xi = k % 4 == 0 ? rnd(0, 1) : k % 4 == 1 ? rnd(cells - 1, cells) : rnd(0, cells);
+		idx_t i0;
+		double w[SHAPE_SUPPORT_MAX], dw[SHAPE_SUPPORT_MAX];
+		shape_1d(kind, xi, cells, inv_h, &i0, w, dw);
+		if (i0 < 0 || i0 + S - 1 > cells)
+			out_of_range++;
+		double sum = 0, gsum = 0;
+		for (int a = 0; a < S; a++) {
+			sum += w[a], gsum += dw[a];
+			min_w = fmin(min_w, w[a]);
+		}
+		worst_sum = fmax(worst_sum, fabs(sum - 1));
+		worst_grad = fmax(worst_grad, fabs(gsum) * h);
+		/* finite difference of node i0+a's weight in x (in metres) */
+		const double eps = 1e-6;
+		double half = 2 * xi;   /* pieces join at integers (linear) and half-integers (quadratic) */
+		if (xi > eps && xi < cells - eps && fabs(half - round(half)) > 1e-4) {
+			for (int a = 0; a < S; a++) {
+				double wp[SHAPE_SUPPORT_MAX], wm[SHAPE_SUPPORT_MAX], d[SHAPE_SUPPORT_MAX];
+				idx_t ip, im;
+				shape_1d(kind, xi + eps, cells, inv_h, &ip, wp, d);
+				shape_1d(kind, xi - eps, cells, inv_h, &im, wm, d);
+				double vp = 0, vm = 0;   /* weight of node i0+a seen from either side */
+				if (i0 + a - ip >= 0 && i0 + a - ip < S) vp = wp[i0 + a - ip];
+				if (i0 + a - im >= 0 && i0 + a - im < S) vm = wm[i0 + a - im];
+				double fd = (vp - vm) / (2 * eps * h);
+				worst_fd = fmax(worst_fd, fabs(fd - dw[a]) * h);
+			}
+		}
+	}
+	char name[96];
+	printf("INFO %s: max |sum S - 1| = %.2e, max |sum dS| h = %.2e, max FD gradient error %.2e, min S %.2e\n",
+	       label, worst_sum, worst_grad, worst_fd, min_w);
+	snprintf(name, sizeof name, "%s_partition_of_unity", label);
+	CHECK(worst_sum < 1e-14, name, "max |sum - 1| = %.3e", worst_sum);
+	snprintf(name, sizeof name, "%s_gradient_sum_zero", label);
+	CHECK(worst_grad < 1e-13, name, "max |sum dS| h = %.3e", worst_grad);
+	snprintf(name, sizeof name, "%s_gradient_matches_finite_difference", label);
+	CHECK(worst_fd < 1e-6, name, "max error %.3e", worst_fd);
+	snprintf(name, sizeof name, "%s_non_negative", label);
+	CHECK(min_w >= 0, name, "min weight %.3e", min_w);
+	snprintf(name, sizeof name, "%s_support_inside_grid", label);
+	CHECK(out_of_range == 0, name, "%d samples reach beyond the grid", out_of_range);
+
+	/* interpolating at the edges: the edge node's weight is 1 there */
+	idx_t i0;
+	double w[SHAPE_SUPPORT_MAX], dw[SHAPE_SUPPORT_MAX];
+	shape_1d(kind, 0.0, cells, inv_h, &i0, w, dw);
+	int lower = i0 == 0 && fabs(w[0] - 1) < 1e-15;
+	shape_1d(kind, (double)cells, cells, inv_h, &i0, w, dw);
+	int upper = i0 + S - 1 == cells && fabs(w[S - 1] - 1) < 1e-15;
+	snprintf(name, sizeof name, "%s_interpolating_at_edges", label);
+	CHECK(lower && upper, name, "edge weights not 1");
+	snprintf(name, sizeof name, "%s_outside_rejected", label);
+	CHECK(shape_1d(kind, -1e-9, cells, inv_h, &i0, w, dw) == -1 &&
+	      shape_1d(kind, cells + 1e-9, cells, inv_h, &i0, w, dw) == -1, name, "a point outside was accepted");
+}
+
+/* 2-D: the tensor product keeps both properties at random points of a whole grid. */
+static void check_2d(enum case_shape kind, const char *label)
+{
+	struct case_grid spec = {.origin = {-1.234, 0.567}, .extent = {6 * 0.0413, 5 * 0.0413}, .cell_size = 0.0413};
+	struct grid g;
+	grid_init(&g, &spec, NULL);
+	struct particles p;
+	particles_init(&p, 5000, 0, NULL);
+	for (idx_t q = 0; q < p.n; q++) {
+		p.x[2 * q] = spec.origin[0] + rnd(0, spec.extent[0]);
+		p.x[2 * q + 1] = spec.origin[1] + rnd(0, spec.extent[1]);
+	}
+	enum poro_status st = shape_evaluate(&g, kind, &p, "test", NULL);
+	int S = p.support, nn = S * S;
+	double worst = 0, worst_g = 0;
+	for (idx_t q = 0; q < p.n; q++) {
+		double s = 0, gx = 0, gy = 0;
+		for (int k = 0; k < nn; k++) {
+			s += p.w[q * nn + k];
+			gx += p.dw[2 * (q * nn + k)], gy += p.dw[2 * (q * nn + k) + 1];
+		}
+		worst = fmax(worst, fabs(s - 1));
+		worst_g = fmax(worst_g, fmax(fabs(gx), fabs(gy)) * g.h);
+	}
+	char name[96];
+	snprintf(name, sizeof name, "%s_2d_partition_and_gradient", label);
+	CHECK(st == PORO_OK && worst < 1e-14 && worst_g < 1e-13, name, "sum err %.3e grad %.3e", worst, worst_g);
+	p.x[0] = spec.origin[0] - 1e-6;
+	struct poro_error err = {0};
+	st = shape_evaluate(&g, kind, &p, "soil", &err);
+	snprintf(name, sizeof name, "%s_point_outside_grid_reported", label);
+	CHECK(st == PORO_ESOLVER && strstr(err.message, "soil point 0 left the grid"), name, "status %d '%s'", st, err.message);
+	particles_release(&p);
+}
+
+int main(void)
+{
+	check_kind(SHAPE_LINEAR, "linear");
+	check_kind(SHAPE_QUADRATIC_BSPLINE, "quadratic_bspline");
+	check_2d(SHAPE_LINEAR, "linear");
+	check_2d(SHAPE_QUADRATIC_BSPLINE, "quadratic_bspline");
+	HARNESS_EXIT();
+}

@@ -1,0 +1,81 @@
+/*
+ * analytic.h - closed-form consolidation solutions the verification tests compare against.
+ *
+ * Terzaghi (000 Eqs. 84-86, with the known extraction slip of Eq. 84 corrected: the exponential
+ * multiplies each term of the series): excess pore pressure at depth z below the drained face,
+ * drainage length H, time factor Tv = c_v t / H^2 with c_v = k / (rho_w g m_v).
+ *
+ * Xie and Leo (2004) large-strain consolidation (000 Eqs. 87-90, 002 Eqs. 35-37): settlement
+ * S = H (1 - exp(-m_v q)) U(Tv) and pore pressure p = ln[1 + (exp(m_v q) - 1) sum] / m_v with the
+ * same series as Terzaghi. 000 writes the series with 4 M^2 Tv and sin(2 M z / H), which is the
+ * same solution with H the thickness of a layer drained on both faces; for the singly drained
+ * column used here the drainage length is the column height and the series is the one below
+ * (002 Eq. 36 writes it this way).
+ */
+#ifndef PORO_ANALYTIC_H
+#define PORO_ANALYTIC_H
+
+#include <math.h>
+
+#define ANALYTIC_TERMS 400
+#ifndef M_PI
+#define M_PI 3.14159265358979323846
+#endif
+
+/* sum_m (2/M) sin(M z/H) exp(-M^2 Tv), M = (m + 1/2) pi: the normalised excess pore pressure. */
+static inline double consolidation_series(double z, double H, double Tv)
+{
+	double sum = 0.0;
+	for (int m = 0; m < ANALYTIC_TERMS; m++) {
+		double M = (m + 0.5) * M_PI;
+		sum += 2.0 / M * sin(M * z / H) * exp(-M * M * Tv);
+	}
+	return sum;
+}
+
+/* Terzaghi excess pore pressure, Pa, for load q at depth z below the drained face. */
+static inline double terzaghi_pressure(double z, double H, double Tv, double q)
+{
+	if (z <= 0.0)
+		return 0.0;
+	return q * consolidation_series(z, H, Tv);
+}
+
+/* Average degree of consolidation U(Tv) = 1 - sum 2/M^2 exp(-M^2 Tv). */
+static inline double consolidation_degree(double Tv)
+{
+	double sum = 0.0;
+	for (int m = 0; m < ANALYTIC_TERMS; m++) {
+		double M = (m + 0.5) * M_PI;
+		sum += 2.0 / (M * M) * exp(-M * M * Tv);
+	}
+	return 1.0 - sum;
+}
+
+/* Xie-Leo settlement (000 Eq. 87 in the single-drainage normalisation), m. */
+static inline double xie_leo_settlement(double H, double mv, double q, double Tv)
+{
+	return H * (1.0 - exp(-mv * q)) * consolidation_degree(Tv);
+}
+
+/* Xie-Leo pore pressure at material depth z below the drained top (000 Eq. 90), Pa. */
+static inline double xie_leo_pressure(double z, double H, double mv, double q, double Tv)
+{
+	if (z <= 0.0)
+		return 0.0;
+	return log(1.0 + (exp(mv * q) - 1.0) * consolidation_series(z, H, Tv)) / mv;
+}
+
+/* Time factor Tv = k t / (rho_w g m_v H^2), 000 Eq. 85. */
+static inline double time_factor(double k, double t, double rho_w, double g, double mv, double H)
+{
+	return k * t / (rho_w * g * mv * H * H);
+}
+
+/* Time for a given Tv. */
+static inline double time_for_factor(double k, double Tv, double rho_w, double g, double mv, double H)
+{
+	return Tv * rho_w * g * mv * H * H / k;
+}
+
+#endif
