@@ -64,8 +64,7 @@ struct output {
 	size_t sample_count, sample_capacity;
 	hsize_t samples_written;        /* length of every probe dataset */
 
-	struct xdmf_frame *frames;      /* [frame_capacity] completed frames */
-	size_t frame_count, frame_capacity;
+	struct xdmf_index xdmf;         /* the completed frames, as result.xdmf lists them */
 	long frame_next;                /* sequence number of the next frame group */
 
 	double *scratch;                /* [scratch_capacity] derived fields of one set */
@@ -605,25 +604,6 @@ enum poro_status output_create(struct output **out, const char *dir, const char 
 
 /* ---- frames ------------------------------------------------------------------------------------ */
 
-static enum poro_status frame_remember(struct output *o, const struct output_frame *f, struct poro_error *err)
-{
-	if (o->frame_count == o->frame_capacity) {
-		size_t cap = o->frame_capacity ? 2 * o->frame_capacity : 64;
-		struct xdmf_frame *fr = realloc(o->frames, cap * sizeof *fr);
-		if (!fr)
-			return no_memory(err, "the frame list");
-		o->frames = fr;
-		o->frame_capacity = cap;
-	}
-	o->frames[o->frame_count++] = (struct xdmf_frame){
-		.index = o->frame_next,
-		.time = f->time,
-		.soil_n = f->soil->n,
-		.water_n = f->water ? f->water->n : -1,
-	};
-	return PORO_OK;
-}
-
 static enum poro_status frame_groups(struct output *o, const char *path, const struct output_frame *f,
 				     struct poro_error *err)
 {
@@ -661,9 +641,9 @@ enum poro_status output_frame_write(struct output *o, const struct output_frame 
 		reason_clear();
 		return st;
 	}
-	st = frame_remember(o, f, err);
-	o->frame_next++;
-	return st ? st : xdmf_write(o->dir, o->frames, o->frame_count, err);
+	struct xdmf_frame listed = {o->frame_next++, f->time, f->soil->n, f->water ? f->water->n : -1};
+	st = xdmf_index_add(&o->xdmf, &listed, err);
+	return st ? st : xdmf_index_write(&o->xdmf, o->dir, err);
 }
 
 /* ---- end of the run ------------------------------------------------------------------------------ */
@@ -740,7 +720,7 @@ void output_destroy(struct output **op)
 	free(o->probes);
 	free(o->sample_time);
 	free(o->sample_value);
-	free(o->frames);
+	xdmf_index_release(&o->xdmf);
 	free(o->scratch);
 	free(o->dir);
 	free(o->path);

@@ -14,9 +14,10 @@
  * its components in VTK's order (xx, yy, zz, xy, yz, xz) and its XDMF 2 reader in upper-triangle
  * order (xx, xy, xz, yy, yz, zz), so a 6-component stress would read differently in each.
  *
- * The whole index is rewritten after every frame (a few kB per frame), into a temporary file that
- * is fsync'ed and renamed over the old one: a reader sees the old index or the new one, never a
- * torn one, and never a frame that is not yet flushed into result.h5.
+ * The whole index is rewritten after every frame (about 3.5 kB per double-point frame), into a
+ * temporary file that is fsync'ed and renamed over the old one: a reader sees the old index or
+ * the new one, never a torn one, and never a frame that is not yet flushed into result.h5. Each
+ * frame's XML is formatted once and kept in memory, so a rewrite costs one write of the file.
  */
 #include "output_xdmf.h"
 
@@ -100,14 +101,44 @@ static void put_frame(FILE *f, const struct xdmf_frame *fr)
 	fprintf(f, "      </Grid>\n");
 }
 
-static void put_index(FILE *f, const struct xdmf_frame *frames, size_t count)
+/* The file around the frames. */
+static const char xdmf_head[] =
+	"<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n"
+	"<Xdmf Version=\"3.0\">\n  <Domain>\n"
+	"    <Grid Name=\"frames\" GridType=\"Collection\" CollectionType=\"Temporal\">\n";
+static const char xdmf_tail[] = "    </Grid>\n  </Domain>\n</Xdmf>\n";
+
+enum poro_status xdmf_index_add(struct xdmf_index *x, const struct xdmf_frame *frame, struct poro_error *err)
 {
-	fprintf(f, "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n");
-	fprintf(f, "<Xdmf Version=\"3.0\">\n  <Domain>\n");
-	fprintf(f, "    <Grid Name=\"frames\" GridType=\"Collection\" CollectionType=\"Temporal\">\n");
-	for (size_t i = 0; i < count; i++)
-		put_frame(f, &frames[i]);
-	fprintf(f, "    </Grid>\n  </Domain>\n</Xdmf>\n");
+	char *text = NULL;
+	size_t len = 0;
+	FILE *m = open_memstream(&text, &len);
+	if (m) {
+		put_frame(m, frame);
+		if (fclose(m) != 0) {
+			free(text);
+			text = NULL;
+		}
+	}
+	if (text && x->len + len > x->cap) {
+		size_t cap = x->cap ? 2 * x->cap : 64 * 1024;
+		while (cap < x->len + len)
+			cap *= 2;
+		char *grown = realloc(x->text, cap);
+		if (grown) {
+			x->text = grown;
+			x->cap = cap;
+		}
+	}
+	if (!text || x->len + len > x->cap) {
+		free(text);
+		return poro_error_set(err, PORO_ENOMEM, "cannot allocate the xdmf index");
+	}
+	memcpy(x->text + x->len, text, len);
+	x->len += len;
+	x->frames++;
+	free(text);
+	return PORO_OK;
 }
 
 static char *join(const char *dir, const char *name)
@@ -119,8 +150,7 @@ static char *join(const char *dir, const char *name)
 	return path;
 }
 
-enum poro_status xdmf_write(const char *dir, const struct xdmf_frame *frames, size_t count,
-			    struct poro_error *err)
+enum poro_status xdmf_index_write(const struct xdmf_index *x, const char *dir, struct poro_error *err)
 {
 	char *tmp = join(dir, OUTPUT_XDMF_TMP_NAME);
 	char *path = join(dir, OUTPUT_XDMF_NAME);
@@ -134,7 +164,10 @@ enum poro_status xdmf_write(const char *dir, const struct xdmf_frame *frames, si
 		st = poro_error_set(err, PORO_EIO, "cannot create '%s': %s", tmp, strerror(errno));
 		goto out;
 	}
-	put_index(f, frames, count);
+	fputs(xdmf_head, f);
+	if (x->len)
+		fwrite(x->text, 1, x->len, f);
+	fputs(xdmf_tail, f);
 	/* fflush + fsync before rename: the new name must never point at data still in flight */
 	int failed = ferror(f) || fflush(f) != 0 || fsync(fileno(f)) != 0;
 	int saved = errno;
@@ -156,4 +189,10 @@ out:
 	free(tmp);
 	free(path);
 	return st;
+}
+
+void xdmf_index_release(struct xdmf_index *x)
+{
+	free(x->text);
+	*x = (struct xdmf_index){0};
 }

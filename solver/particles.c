@@ -66,6 +66,20 @@ enum poro_status particles_init_alias(struct particles *w, const struct particle
 	return PORO_OK;
 }
 
+void particles_remove(struct particles *p, idx_t q)
+{
+	idx_t last = p->n - 1;
+	if (q != last) {
+#define MOVE(name, width, wanted) \
+		if (p->name) memcpy(p->name + (size_t)q * (width), p->name + (size_t)last * (width), sizeof(double) * (width));
+		PARTICLE_ARRAYS(MOVE, 0)
+#undef MOVE
+		p->body[q] = p->body[last];
+		p->node0[q] = p->node0[last];
+	}
+	p->n--;
+}
+
 void particles_release(struct particles *p)
 {
 	if (!p)

@@ -69,6 +69,10 @@ enum poro_status particles_init(struct particles *p, idx_t n, int with_skeleton,
  * porosity0, body and the shape cache; owns v, mass, pressure. */
 enum poro_status particles_init_alias(struct particles *w, const struct particles *soil, struct poro_error *err);
 
+/* Removes point q by moving the last point into its place (order is not kept). Not for aliased
+ * sets or sets with skeleton arrays. */
+void particles_remove(struct particles *p, idx_t q);
+
 void particles_release(struct particles *p);
 
 #endif

@@ -51,8 +51,12 @@ void sim_pore_pressure(const struct sim *s, double *pressure, double *positions)
  * sum n rho_w V over water points (double point; single point: the water in the pores). */
 double sim_soil_mass(const struct sim *s);
 double sim_water_mass(const struct sim *s);
-/* Sum of nodal soil and water-point masses after the last P2G (partition of unity check). */
-void sim_grid_masses(const struct sim *s, double *soil, double *water_points);
+/* Water mass that left the grid through drained faces (double point), kg per m. */
+double sim_water_outflow_mass(const struct sim *s);
+/* Nodal soil and water-point mass sums of the last P2G, and the point mass sums they were mapped
+ * from (they agree to rounding by the partition of unity). */
+void sim_grid_masses(const struct sim *s, double *grid_soil, double *grid_water, double *point_soil,
+		     double *point_water);
 
 /* Value of probe i of the case at the current state (units: Pa, m). */
 double sim_probe_value(const struct sim *s, int i);

@@ -5,6 +5,7 @@
  * box at the time of sampling.
  */
 #include <float.h>
+#include <math.h>
 
 #include "sim_internal.h"
 
@@ -54,7 +55,7 @@ double sim_probe_value(const struct sim *s, int i)
 	int q = s->probe_point[i];
 	switch (pr->kind) {
 	case PROBE_PORE_PRESSURE:
-		return -s->water.pressure[q];
+		return q >= 0 ? -s->water.pressure[q] : NAN;   /* its point drained out of the grid */
 	case PROBE_DISPLACEMENT:
 		return s->soil.x[2 * q + pr->component] - s->soil.x0[2 * q + pr->component];
 	case PROBE_AVERAGE: {

@@ -77,6 +77,9 @@ static void map_soil_to_grid(struct sim *s)
 	const struct particles *p = &s->soil;
 	struct grid_fields *f = &s->f;
 	p2g_scalar(&s->grid, p, NULL, p->mass, f->mass_s);
+	s->mapped_mass_s = 0.0;
+	for (idx_t q = 0; q < p->n; q++)
+		s->mapped_mass_s += p->mass[q];
 	p2g_vector(&s->grid, p, p->mass, p->v, f->v_s);
 	p2g_scalar(&s->grid, p, p->mass, p->porosity, f->porosity);
 	p2g_scalar(&s->grid, p, p->mass, p->conductivity, f->conductivity);
@@ -111,6 +114,9 @@ static void map_water_to_grid(struct sim *s)
 		w->mass[q] = w->porosity[q] * s->rho_w * w->volume[q];
 	p2g_scalar(&s->grid, w, NULL, w->volume, f->mass_w_v);
 	p2g_scalar(&s->grid, w, NULL, w->mass, f->mass_w_points);
+	s->mapped_mass_w = 0.0;
+	for (idx_t q = 0; q < w->n; q++)
+		s->mapped_mass_w += w->mass[q];
 	p2g_vector(&s->grid, w, w->mass, w->v, f->v_w);
 	p2g_scalar(&s->grid, w, w->mass, w->pressure, f->pressure);
 	normalise(nodes, f->v_w, 2, f->mass_w_points);
@@ -229,6 +235,35 @@ static void update_points(struct sim *s)
 	}
 }
 
+/* Water points that crossed a drained grid face have left the domain: they are removed and
+ * their mass booked as outflow, so the water balance stays checkable (double point only: the
+ * single-point water has no points of its own). Point probes following a removed point stop. */
+static void remove_drained_water(struct sim *s)
+{
+	struct particles *w = &s->water;
+	const struct grid *g = &s->grid;
+	const struct case_boundary *bc = s->spec->boundaries;
+	if (!s->double_point)
+		return;
+	for (idx_t q = w->n - 1; q >= 0; q--) {
+		double xi = (w->x[2 * q] - g->origin[0]) * g->inv_h, eta = (w->x[2 * q + 1] - g->origin[1]) * g->inv_h;
+		int face = xi < 0 ? FACE_LEFT : xi > g->cells[0] ? FACE_RIGHT :
+			   eta < 0 ? FACE_BOTTOM : eta > g->cells[1] ? FACE_TOP : -1;
+		if (face < 0 || bc[face].drainage != DRAINAGE_DRAINED)
+			continue;
+		s->water_outflow_mass += w->mass[q];
+		for (int i = 0; i < s->spec->probe_count; i++) {
+			if (s->spec->probes[i].kind != PROBE_PORE_PRESSURE)
+				continue;
+			if (s->probe_point[i] == q)
+				s->probe_point[i] = -1;
+			else if (s->probe_point[i] == w->n - 1)
+				s->probe_point[i] = (int)q;
+		}
+		particles_remove(w, q);
+	}
+}
+
 /* Step 8: MUSL displacement increment (8a), deformation gradient increment (8b-c), volume,
  * Jacobian and porosity (8d-f), Kozeny-Carman conductivity (8g). */
 static enum poro_status update_soil_kinematics(struct sim *s)
@@ -305,6 +340,7 @@ enum poro_status semi_implicit_step(struct sim *s)
 	TRY(pressure_solve(s));                                 /* (5) Eq. 60 */
 	correct_velocities(s);                                  /* (6) Eqs. 64-65 */
 	update_points(s);                                       /* (7) */
+	remove_drained_water(s);
 	TRY(update_soil_kinematics(s));                         /* (8) */
 	TRY(update_stress(s));                                  /* (10) */
 	s->time = (double)(s->step + 1) * s->dt;   /* no drift from summing dt */

@@ -253,13 +253,18 @@ double sim_water_mass(const struct sim *s)
 	return m;
 }
 
-void sim_grid_masses(const struct sim *s, double *soil, double *water_points)
+double sim_water_outflow_mass(const struct sim *s) { return s->water_outflow_mass; }
+
+void sim_grid_masses(const struct sim *s, double *grid_soil, double *grid_water, double *point_soil,
+		     double *point_water)
 {
 	double ms = 0.0, mw = 0.0;
 	for (idx_t I = 0; I < s->grid.node_count; I++) {
 		ms += s->f.mass_s[I];
 		mw += s->f.mass_w_points[I];
 	}
-	*soil = ms;
-	*water_points = mw;
+	*grid_soil = ms;
+	*grid_water = mw;
+	*point_soil = s->mapped_mass_s;
+	*point_water = s->mapped_mass_w;
 }

@@ -49,6 +49,8 @@ struct sim {
 	double *water_scalar;         /* [n_water] */
 	double *water_coef;           /* [n_water] */
 
+	double mapped_mass_s, mapped_mass_w; /* point mass sums mapped in the last P2G, kg/m */
+	double water_outflow_mass;    /* kg/m of water points that left through drained faces */
 	int *probe_point;             /* [probe_count] tracked point of point probes, -1 otherwise */
 	struct poro_error err;
 };
