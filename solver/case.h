@@ -20,6 +20,9 @@
 enum case_scheme { SCHEME_SEMI_IMPLICIT };
 enum case_phases { PHASES_DOUBLE_POINT, PHASES_SINGLE_POINT };
 enum case_shape { SHAPE_LINEAR, SHAPE_QUADRATIC_BSPLINE };
+/* The matrix of the pressure solve: the Laplacian of 000 Eq. 61, or the projection G^T M^-1 G
+ * consistent with the velocity correction (docs/numerics.md compares them). */
+enum pressure_projection { PROJECTION_LAPLACIAN, PROJECTION_CONSISTENT };
 
 enum material_model { MODEL_LINEAR_ELASTIC, MODEL_HENCKY };
 
@@ -45,6 +48,7 @@ struct case_formulation {
 	enum case_shape shape;            /* "linear" or "quadratic_bspline" (default) */
 	int pore_pressure_smoothing;      /* node-wise smoothing, 000 Eq. 77; default true */
 	double flip_fraction;             /* 1 = pure FLIP (default), 0 = PIC; velocity update blend */
+	enum pressure_projection pressure_projection; /* "laplacian" (default) or "consistent" */
 };
 
 struct case_grid {

@@ -54,6 +54,7 @@ static const char *const schema_names[] = { CASE_SCHEMA_VERSION, NULL };
 static const char *const scheme_names[] = { "semi_implicit", NULL };
 static const char *const phases_names[] = { "double_point", "single_point", NULL };
 static const char *const shape_names[] = { "linear", "quadratic_bspline", NULL };
+static const char *const projection_names[] = { "laplacian", "consistent", NULL };
 static const char *const model_names[] = { "linear_elastic", "hencky", NULL };
 static const char *const permeability_law_names[] = { "constant", "kozeny_carman", NULL };
 static const char *const constraint_names[] = { "free", "slip", "fixed", NULL };
@@ -70,7 +71,7 @@ static const char *const top_keys[] = { "schema", "title", "formulation", "grid"
 					"fluid", "gravity", "boundaries", "loads", "time", "output",
 					"probes", NULL };
 static const char *const formulation_keys[] = { "scheme", "phases", "shape", "pore_pressure_smoothing",
-						"flip_fraction", NULL };
+						"flip_fraction", "pressure_projection", NULL };
 static const char *const grid_keys[] = { "origin", "extent", "cell_size", NULL };
 static const char *const material_keys[] = { "name", "model", "density", "youngs_modulus",
 					     "poisson_ratio", NULL };
@@ -236,6 +237,8 @@ static void read_formulation(struct case_reader *r, const json_t *root, struct c
 	f->shape = read_choice_or(r, o, p, "shape", CASE_OPTIONAL, shape_names, f->shape);
 	case_read_bool(r, o, p, "pore_pressure_smoothing", CASE_OPTIONAL, &f->pore_pressure_smoothing);
 	case_read_number(r, o, p, "flip_fraction", CASE_OPTIONAL, &FRACTION, &f->flip_fraction);
+	f->pressure_projection = read_choice_or(r, o, p, "pressure_projection", CASE_OPTIONAL, projection_names,
+						f->pressure_projection);
 }
 
 /* Checks that extent[d] is a whole number, at least GRID_CELLS_MIN, of cells. */

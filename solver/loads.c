@@ -7,12 +7,12 @@
  * of the face, N dA = outward normal times the point spacing h / particles_per_cell, in the
  * reference configuration; the current share follows Nanson's formula da = J F^-T N dA, so a load
  * keeps acting on the material face as it deforms. The traction vector is a dead load (fixed
- * direction) scaled by its time function.
+ * direction) scaled by its time function. It is applied at the face midpoint (see below).
  */
 #include <math.h>
 
+#include "shape.h"
 #include "sim_internal.h"
-#include "transfer.h"
 
 void loads_init(struct sim *s)
 {
@@ -38,24 +38,37 @@ void loads_init(struct sim *s)
 	}
 }
 
+/* The traction of a loaded point acts on its face, not at its centre: the face midpoint is the
+ * centre plus F (N / |N|) d / 2 (d the point spacing). Mapping the load at the centre instead
+ * gives the nodes beyond the surface a quarter of the load their share of the stress divergence
+ * asks for, and the surplus accelerates those low-mass nodes without bound. */
 void loads_add_tractions(struct sim *s, double time, double *force)
 {
 	const struct case_spec *c = s->spec;
 	const struct particles *p = &s->soil;
-	double *traction = s->soil_grad;   /* per-point force, N/m; scratch is free during step 4 */
+	const int S = p->support, nn = S * S;
 	for (idx_t q = 0; q < p->n; q++) {
 		int l = p->surface_load[q];
-		traction[2 * q] = traction[2 * q + 1] = 0.0;
 		if (l < 0)
 			continue;
 		const double *F = p->F + 4 * q, *N = p->surface + 2 * q;
 		/* J F^-T N in 2-D: [[F11, -F10], [-F01, F00]] N */
 		double ax = F[3] * N[0] - F[2] * N[1], ay = -F[1] * N[0] + F[0] * N[1];
 		double area = hypot(ax, ay) * case_time_function_value(&c->loads[l].time_function, time);
-		traction[2 * q] = c->loads[l].traction[0] * area;
-		traction[2 * q + 1] = c->loads[l].traction[1] * area;
+		double tx = c->loads[l].traction[0] * area, ty = c->loads[l].traction[1] * area;
+		/* N has length d, so F N / 2 reaches from the centre to the face */
+		double face[2] = {p->x[2 * q] + 0.5 * (F[0] * N[0] + F[1] * N[1]),
+				  p->x[2 * q + 1] + 0.5 * (F[2] * N[0] + F[3] * N[1])};
+		double w[SHAPE_NODES_MAX];
+		idx_t node0;
+		if (shape_weights_at(&s->grid, c->formulation.shape, face, &node0, w))
+			continue;   /* the face left the grid: the point itself is reported by step 1 */
+		for (int k = 0; k < nn; k++) {
+			idx_t I = node0 + k % S + (k / S) * s->grid.nodes[0];
+			force[2 * I] += w[k] * tx;
+			force[2 * I + 1] += w[k] * ty;
+		}
 	}
-	p2g_vector(&s->grid, p, NULL, traction, force);
 }
 
 void loads_gravity(const struct case_spec *c, double time, double b[2])

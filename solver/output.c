@@ -18,7 +18,7 @@
  * probe datasets grow in place. So a run killed while it writes a frame loses that frame only.
  * What no HDF5 1.10 file without SWMR (which needs the newest format) can promise is a
  * crash-consistent order of the writes inside one flush; the window is the flush itself, a few
- * milliseconds per frame; in stress runs of the SIGKILL test in tests/solver/output_test.c (400
+ * milliseconds per frame; in stress runs of the SIGKILL test in tests/solver/output_test.c (550
  * kills at random moments, up to 120 frames into a run) no completed frame was ever damaged.
  *
  * Signs and units: SI throughout; pore pressure is stored internally tension positive

@@ -1,18 +1,31 @@
 /*
  * pressure.c - the pore-pressure increment of the semi-implicit scheme (000 §4.5 step 5):
- * free-surface detection, assembly of dt L dp = D_s v_s* + D_w v_w* (Eqs. 60-63), and its solve.
+ * free-surface detection, the pressure matrix and right-hand side, and the solve.
  *
- * L (Eq. 61) is assembled as sum_p c_p grad S_Ip . grad S_Jp with c_p = V_sp (1 - n_sp) / rho_s for
- * soil points and V_wp n_wp / rho_w for water points. The paper writes the porosity as a nodal
- * factor of row I, which makes L unsymmetric wherever porosity varies; keeping it inside the sum
- * is the plain Galerkin discretisation of Eq. 32 (where n^t sits inside the integral), equal to
- * the paper's form for uniform porosity, and keeps L symmetric positive definite for CHOLMOD.
- * The divergence terms D_s, D_w (Eqs. 62-63) keep the paper's nodal porosity factors.
+ * Two matrices are offered (case key formulation.pressure_projection):
+ *  - "laplacian" (default, the paper): L dp = (D_s v_s* + D_w v_w*) / dt, Eqs. 60-63. L (Eq. 61) is
+ *    assembled as sum_p c_p grad S_Ip . grad S_Jp with c_p = V_sp (1 - n_sp) / rho_s for soil points
+ *    and V_wp n_wp / rho_w for water points. The paper writes the porosity as a nodal factor of
+ *    row I, which makes L unsymmetric wherever porosity varies; keeping it inside the sum is the
+ *    Galerkin discretisation of Eq. 32 (where n^t is inside the integral), equal to the paper's
+ *    form for uniform porosity, and keeps L symmetric positive definite for CHOLMOD. D_s, D_w keep
+ *    the paper's nodal porosity factors.
+ *  - "consistent": A dp = -sum_a G_a^T v_a* / dt with A = sum_a G_a^T M_a^-1 G_a over the free
+ *    velocity components, G_a the gradient operators of the correction (Eqs. 67-68). The corrected
+ *    velocities then satisfy the weak continuity equation -G^T v = 0 exactly, and the pressure
+ *    forces of the predictors use the same G on the nodal pressure, so a pressure error is removed
+ *    in one step instead of being fed back (docs/numerics.md has the measurements).
  *
  * Boundary conditions: impermeable faces need nothing (the natural condition of Eq. 32). Nodes
  * on the free water surface and on drained faces get p^{t+1} = 0, i.e. dp_I = -p^t_I. A node is
- * on the free surface when a cell next to it (inside the grid) holds no pressure-carrying point
- * (after Kularathna and Soga, cited in 000 step 5b); cells beyond the grid edge are walls.
+ * on the free surface when a cell next to it (inside the grid) is not full: the volumes of the
+ * water points in it, and those of the soil points (the soil is saturated, 000 §2), each add up to
+ * less than FREE_SURFACE_FILL of the cell (after Kularathna and Soga, cited in 000 step 5b).
+ * Counting soil matters at drained faces, where outflowing water points leave gaps in the cells
+ * next to the face that would otherwise move the drained boundary into the soil. Counting merely occupied cells is not enough: a
+ * single expelled water point in the cell above the soil would move the free surface a whole cell
+ * up. Beyond a grid face where the water is unconstrained lies open air, so the cells there count
+ * as dry; beyond a wall, they do not count.
  */
 #include <stdlib.h>
 #include <string.h>
@@ -20,22 +33,32 @@
 #include "sim_internal.h"
 #include "transfer.h"
 
+/* A cell is full (below the free surface) when its points' volumes reach this fraction of it. */
+#define FREE_SURFACE_FILL 0.5
+
 enum poro_status pressure_system_init(struct pressure_system *ps, const struct grid *g, int support,
-				      struct poro_error *err)
+				      enum pressure_projection projection, struct poro_error *err)
 {
 	memset(ps, 0, sizeof *ps);
-	ps->radius = support - 1;
+	ps->exact = projection == PROJECTION_CONSISTENT;
+	ps->g_radius = support - 1;
+	ps->g_width = 2 * ps->g_radius + 1;
+	ps->radius = ps->exact ? 2 * ps->g_radius : ps->g_radius;
 	ps->width = 2 * ps->radius + 1;
 	const size_t nodes = (size_t)g->node_count, st = (size_t)ps->width * ps->width;
+	const size_t gst = (size_t)ps->g_width * ps->g_width * 2;
 	const size_t nnz_max = nodes * (st + 1) / 2;
 	ps->stencil = calloc(nodes * st, sizeof(double));
+	ps->grad_s = calloc(nodes * gst, sizeof(double));
+	ps->grad_w = calloc(nodes * gst, sizeof(double));
 	ps->unknown = malloc(nodes * sizeof(idx_t));
 	ps->colptr = malloc((nodes + 1) * sizeof(idx_t));
 	ps->rowidx = malloc(nnz_max * sizeof(idx_t));
 	ps->values = malloc(nnz_max * sizeof(double));
 	ps->b = malloc(nodes * sizeof(double));
 	ps->x = malloc(nodes * sizeof(double));
-	if (!ps->stencil || !ps->unknown || !ps->colptr || !ps->rowidx || !ps->values || !ps->b || !ps->x) {
+	if (!ps->stencil || !ps->grad_s || !ps->grad_w || !ps->unknown || !ps->colptr || !ps->rowidx ||
+	    !ps->values || !ps->b || !ps->x) {
 		pressure_system_release(ps);
 		return poro_error_set(err, PORO_ENOMEM, "cannot allocate the pressure system");
 	}
@@ -45,6 +68,8 @@ enum poro_status pressure_system_init(struct pressure_system *ps, const struct g
 void pressure_system_release(struct pressure_system *ps)
 {
 	free(ps->stencil);
+	free(ps->grad_s);
+	free(ps->grad_w);
 	free(ps->unknown);
 	free(ps->colptr);
 	free(ps->rowidx);
@@ -61,22 +86,38 @@ void pressure_mark_dirichlet(struct sim *s)
 	const struct grid *g = &s->grid;
 	struct grid_fields *f = &s->f;
 	const struct particles *w = &s->water;
+	/* a cell is full if its water points, or its (saturated) soil points, fill it */
+	const double full = FREE_SURFACE_FILL * g->h * g->h;
 	memset(f->cell_wet, 0, (size_t)g->cell_count);
-	for (idx_t q = 0; q < w->n; q++) {
-		idx_t c = grid_cell_of(g, w->x + 2 * q);
-		if (c >= 0)
-			f->cell_wet[c] = 1;
+	const struct particles *sets[2] = {w, s->double_point ? &s->soil : NULL};
+	for (int k = 0; k < 2 && sets[k]; k++) {
+		double *fill = s->cell_fill;
+		memset(fill, 0, sizeof(double) * (size_t)g->cell_count);
+		for (idx_t q = 0; q < sets[k]->n; q++) {
+			idx_t c = grid_cell_of(g, sets[k]->x + 2 * q);
+			if (c >= 0)
+				fill[c] += sets[k]->volume[q];
+		}
+		for (idx_t c = 0; c < g->cell_count; c++)
+			f->cell_wet[c] |= fill[c] >= full;
 	}
+	const struct case_boundary *bc = s->spec->boundaries;
+	/* beyond a face where water moves freely is open air (dry); beyond a wall, nothing */
+	const int open[FACE_COUNT] = {bc[FACE_LEFT].water == CONSTRAINT_FREE, bc[FACE_RIGHT].water == CONSTRAINT_FREE,
+				      bc[FACE_BOTTOM].water == CONSTRAINT_FREE, bc[FACE_TOP].water == CONSTRAINT_FREE};
 	for (idx_t j = 0; j < g->nodes[1]; j++)
 		for (idx_t i = 0; i < g->nodes[0]; i++) {
 			int dry = 0;
 			for (idx_t cj = j - 1; cj <= j; cj++)
-				for (idx_t ci = i - 1; ci <= i; ci++)
+				for (idx_t ci = i - 1; ci <= i; ci++) {
 					if (ci >= 0 && cj >= 0 && ci < g->cells[0] && cj < g->cells[1])
 						dry |= !f->cell_wet[ci + cj * g->cells[0]];
+					else
+						dry |= (ci < 0 && open[FACE_LEFT]) || (ci >= g->cells[0] && open[FACE_RIGHT]) ||
+						       (cj < 0 && open[FACE_BOTTOM]) || (cj >= g->cells[1] && open[FACE_TOP]);
+				}
 			f->dirichlet[grid_node(g, i, j)] = (signed char)dry;
 		}
-	const struct case_boundary *bc = s->spec->boundaries;
 	for (idx_t j = 0; j < g->nodes[1]; j++)
 		for (idx_t i = 0; i < g->nodes[0]; i++) {
 			int drained = (i == 0 && bc[FACE_LEFT].drainage == DRAINAGE_DRAINED) ||
@@ -104,6 +145,105 @@ static void assemble_laplacian(struct sim *s, const struct particles *p, const d
 			for (int l = 0; l < nn; l++) {
 				int dx = l % S - k % S, dy = l / S - k / S;
 				row[(dx + R) + (dy + R) * W] += gx * dw[2 * l] + gy * dw[2 * l + 1];
+			}
+		}
+	}
+}
+
+/* G_IJ = f_I sum_p V_p S_Ip grad S_Jp for one set (Eqs. 67-68 before the nodal porosity factor). */
+static void add_gradient_operator(const struct sim *s, const struct particles *p, double *G)
+{
+	const struct grid *g = &s->grid;
+	const struct pressure_system *ps = &s->ps;
+	const int S = p->support, nn = S * S, W = ps->g_width, R = ps->g_radius;
+	for (idx_t q = 0; q < p->n; q++) {
+		const double *w = p->w + (size_t)q * nn, *dw = p->dw + (size_t)q * 2 * nn;
+		const double V = p->volume[q];
+		for (int k = 0; k < nn; k++) {
+			const idx_t I = p->node0[q] + k % S + (k / S) * g->nodes[0];
+			double *row = G + (size_t)I * W * W * 2;
+			const double vs = V * w[k];
+			for (int l = 0; l < nn; l++) {
+				int off = (l % S - k % S + R) + (l / S - k / S + R) * W;
+				row[2 * off] += vs * dw[2 * l];
+				row[2 * off + 1] += vs * dw[2 * l + 1];
+			}
+		}
+	}
+}
+
+void pressure_gradient_operators(struct sim *s)
+{
+	struct pressure_system *ps = &s->ps;
+	const size_t gst = (size_t)ps->g_width * ps->g_width * 2, nodes = (size_t)s->grid.node_count;
+	memset(ps->grad_s, 0, sizeof(double) * nodes * gst);
+	memset(ps->grad_w, 0, sizeof(double) * nodes * gst);
+	add_gradient_operator(s, &s->soil, ps->grad_s);
+	add_gradient_operator(s, &s->water, ps->grad_w);
+	for (size_t I = 0; I < nodes; I++) {
+		const double n = s->f.porosity[I];
+		for (size_t k = 0; k < gst; k++) {
+			ps->grad_s[I * gst + k] *= 1.0 - n;
+			ps->grad_w[I * gst + k] *= n;
+		}
+	}
+}
+
+void pressure_apply_gradient(const struct sim *s, const double *G, const double *pressure, double *out)
+{
+	const struct grid *g = &s->grid;
+	const int W = s->ps.g_width, R = s->ps.g_radius;
+	for (idx_t I = 0; I < g->node_count; I++) {
+		const idx_t i = I % g->nodes[0], j = I / g->nodes[0];
+		const double *row = G + (size_t)I * W * W * 2;
+		double fx = 0.0, fy = 0.0;
+		for (int dy = -R; dy <= R; dy++)
+			for (int dx = -R; dx <= R; dx++) {
+				if (i + dx < 0 || i + dx >= g->nodes[0] || j + dy < 0 || j + dy >= g->nodes[1])
+					continue;
+				const int off = (dx + R) + (dy + R) * W;
+				const double pJ = pressure[I + dx + dy * g->nodes[0]];
+				fx += row[2 * off] * pJ;
+				fy += row[2 * off + 1] * pJ;
+			}
+		out[2 * I] += fx;
+		out[2 * I + 1] += fy;
+	}
+}
+
+/* A = sum over phases and free velocity components of G^T M^-1 G, and b = -sum G^T v* / dt:
+ * the projection that makes the corrected velocities satisfy -G^T v = 0 exactly. */
+static void assemble_exact_projection(struct sim *s, const double *G, const double *M, const unsigned char *fix,
+				      const double *v_star)
+{
+	const struct grid *g = &s->grid;
+	struct pressure_system *ps = &s->ps;
+	const int Wg = ps->g_width, Rg = ps->g_radius, W = ps->width, R = ps->radius;
+	for (idx_t I = 0; I < g->node_count; I++) {
+		if (!(M[I] > 0.0))
+			continue;
+		const idx_t i = I % g->nodes[0], j = I / g->nodes[0];
+		const double *row = G + (size_t)I * Wg * Wg * 2;
+		for (int c = 0; c < 2; c++) {
+			if (fix[I] & (1 << c))
+				continue;
+			const double inv_m = 1.0 / M[I], vc = v_star[2 * I + c];
+			for (int a = 0; a < Wg * Wg; a++) {
+				const int ax = a % Wg - Rg, ay = a / Wg - Rg;
+				if (i + ax < 0 || i + ax >= g->nodes[0] || j + ay < 0 || j + ay >= g->nodes[1])
+					continue;
+				const double gk = row[2 * a + c];
+				if (gk == 0.0)
+					continue;
+				const idx_t K = I + ax + ay * g->nodes[0];
+				s->f.rhs[K] -= gk * vc / s->dt;
+				double *arow = ps->stencil + (size_t)K * W * W;
+				for (int b = 0; b < Wg * Wg; b++) {
+					const int bx = b % Wg - Rg, by = b / Wg - Rg;
+					if (i + bx < 0 || i + bx >= g->nodes[0] || j + by < 0 || j + by >= g->nodes[1])
+						continue;
+					arow[(bx - ax + R) + (by - ay + R) * W] += gk * row[2 * b + c] * inv_m;
+				}
 			}
 		}
 	}
@@ -175,16 +315,22 @@ enum poro_status pressure_solve(struct sim *s)
 	struct pressure_system *ps = &s->ps;
 	const struct particles *p = &s->soil, *w = &s->water;
 	memset(ps->stencil, 0, sizeof(double) * (size_t)s->grid.node_count * ps->width * ps->width);
-	for (idx_t q = 0; q < p->n; q++) {
-		const double rho_s = s->materials[s->spec->bodies[p->body[q]].material].density;
-		s->soil_coef[q] = p->volume[q] * (1.0 - p->porosity[q]) / rho_s;
-	}
-	for (idx_t q = 0; q < w->n; q++)
-		s->water_coef[q] = w->volume[q] * w->porosity[q] / s->rho_w;
-	assemble_laplacian(s, p, s->soil_coef);
-	assemble_laplacian(s, w, s->water_coef);
 	pressure_mark_dirichlet(s);
-	assemble_rhs(s);
+	if (ps->exact) {
+		memset(s->f.rhs, 0, sizeof(double) * (size_t)s->grid.node_count);
+		assemble_exact_projection(s, ps->grad_s, s->f.mass_s, s->f.fix_s, s->f.v_s_star);
+		assemble_exact_projection(s, ps->grad_w, s->f.mass_w, s->f.fix_w, s->f.v_w_star);
+	} else {
+		for (idx_t q = 0; q < p->n; q++) {
+			const double rho_s = s->materials[s->spec->bodies[p->body[q]].material].density;
+			s->soil_coef[q] = p->volume[q] * (1.0 - p->porosity[q]) / rho_s;
+		}
+		for (idx_t q = 0; q < w->n; q++)
+			s->water_coef[q] = w->volume[q] * w->porosity[q] / s->rho_w;
+		assemble_laplacian(s, p, s->soil_coef);
+		assemble_laplacian(s, w, s->water_coef);
+		assemble_rhs(s);
+	}
 	idx_t n = build_reduced_system(s);
 	enum poro_status st = spd_solver_solve(ps->solver, n, ps->colptr, ps->rowidx, ps->values, ps->b,
 					       ps->x, &s->err);

@@ -20,6 +20,7 @@
  *    within 400 steps; keeping unsmoothed point pressures (p += sum S dp) and smoothing only for
  *    the forces leaves a mode the forces cannot see, which grows at k = 1e-9 m/s. With smoothing
  *    switched off the points keep their pressure and add the interpolated increment;
+ *  - the two predictors are solved together at each node (see predict_velocities);
  *  - in the Laplacian L (Eq. 61) the porosity stays inside the point sum so that L is symmetric
  *    (see pressure.c).
  * Single point: the water set rides on the soil points (same positions, volumes, porosity), so
@@ -126,52 +127,63 @@ static void map_water_to_grid(struct sim *s)
 	memcpy(f->v_w_old, f->v_w, 2 * sizeof(double) * (size_t)nodes);
 }
 
-/* Step 3: explicit water predictor, Eq. 53 with Eqs. 56-59, then the water constraints (3e). */
-static void water_predictor(struct sim *s)
-{
-	struct grid_fields *f = &s->f;
-	const struct particles *w = &s->water;
-	const double dt = s->dt;
-	p2g_internal_force(&s->grid, w, w->volume, NULL, w->pressure, f->force_w);
-	for (idx_t I = 0; I < s->grid.node_count; I++) {
-		const double n = f->porosity[I], Mw = f->mass_w[I];
-		if (!(Mw > 0.0))
-			continue;
-		double Q = 0.0;            /* Eq. 58; no drag where there is no soil */
-		if (f->mass_s[I] > 0.0 && f->conductivity[I] > 0.0)
-			Q = CONDUCTIVITY_GRAVITY * n / f->conductivity[I] * Mw;
-		for (int c = 0; c < 2; c++) {
-			/* F_w^ext - F_w^int: Eq. 56 is M_wI b; Eq. 57 carries the nodal porosity */
-			double force = n * f->force_w[2 * I + c] + Mw * s->gravity[c];
-			f->force_w[2 * I + c] = force;
-			f->v_w_star[2 * I + c] = (dt * (force + Q * f->v_s[2 * I + c]) + Mw * f->v_w[2 * I + c]) /
-						 (Mw + Q * dt);   /* Eq. 59: M_w + Q dt */
-		}
-	}
-	boundary_apply(&s->grid, f->fix_w, f->v_w_star);
-}
-
-/* Step 4: explicit soil predictor, Eq. 52 with Eqs. 54-55, then the soil constraints (4d). */
-static void soil_predictor(struct sim *s)
+/* Steps 3-4: the water and soil predictors (Eqs. 52-53 with Eqs. 54-59).
+ *
+ * The paper evaluates the drag of the water predictor with the old soil velocity (Eq. 25), so
+ * that Eq. 53 gives v_w* alone and Eq. 52 then gives v_s*. The soil then feels the drag
+ * explicitly: an error e in v_s is multiplied each step by 1 - (M_w / M_s) Q dt / (M_w + Q dt),
+ * which leaves (-1, 1) wherever water collects over little soil (M_w / M_s above about 4 for the
+ * Xie-Leo column; the soil surface once expelled water stands on it), and the soil velocity there
+ * grows without bound. We therefore solve the two predictors together at each node:
+ *     M_w (v_w* - v_w) = dt (F_w - Q (v_w* - v_s*))                    (Eq. 53 with v_s*)
+ *     M_s (v_s* - v_s) + M_w (v_w* - v_w) = dt F                        (Eq. 52)
+ * a 2x2 system per node and component with a positive determinant M_s M_w + Q dt (M_s + M_w).
+ * It is still local (no global system), and equals the paper's predictor as Q dt / M_w -> 0.
+ * Nodal forces: F_w = F_w^ext - F_w^int (Eqs. 56-57), F = F^ext - F^int (Eqs. 54-55). */
+static void predict_velocities(struct sim *s)
 {
 	struct grid_fields *f = &s->f;
 	const struct particles *p = &s->soil, *w = &s->water;
+	const double dt = s->dt;
 	p2g_internal_force(&s->grid, p, p->volume, p->stress, NULL, f->force);
-	p2g_internal_force(&s->grid, w, w->volume, NULL, w->pressure, f->force);
-	loads_add_tractions(s, s->time + s->dt, f->force);
+	if (s->ps.exact) {
+		/* pressure forces through the same G the correction uses: G_w p^t and (G_s + G_w) p^t */
+		pressure_gradient_operators(s);
+		pressure_apply_gradient(s, s->ps.grad_w, f->pressure, f->force_w);
+		pressure_apply_gradient(s, s->ps.grad_w, f->pressure, f->force);
+		pressure_apply_gradient(s, s->ps.grad_s, f->pressure, f->force);
+	} else {
+		p2g_internal_force(&s->grid, w, w->volume, NULL, w->pressure, f->force_w);
+		p2g_internal_force(&s->grid, w, w->volume, NULL, w->pressure, f->force);
+	}
+	loads_add_tractions(s, s->time + dt, f->force);
 	for (idx_t I = 0; I < s->grid.node_count; I++) {
-		const double Ms = f->mass_s[I], Mw = f->mass_w[I];
-		if (!(Ms > 0.0))
-			continue;
+		const double n = f->porosity[I], Ms = f->mass_s[I], Mw = f->mass_w[I];
+		double Q = 0.0;            /* Eq. 58; no drag where there is no soil */
+		if (Ms > 0.0 && Mw > 0.0 && f->conductivity[I] > 0.0)
+			Q = CONDUCTIVITY_GRAVITY * n / f->conductivity[I] * Mw;
 		for (int c = 0; c < 2; c++) {
-			/* F^ext = F_w^ext + M_s b + tractions (Eq. 54); F_w^ext = M_w b */
-			double force = f->force[2 * I + c] + (Ms + Mw) * s->gravity[c];
-			f->force[2 * I + c] = force;
-			double dvw = Mw > 0.0 ? f->v_w_star[2 * I + c] - f->v_w[2 * I + c] : 0.0;
-			f->v_s_star[2 * I + c] = (s->dt * force - Mw * dvw) / Ms + f->v_s[2 * I + c];
+			const int k = 2 * I + c;
+			/* Eq. 56 is M_wI b; Eq. 57 carries the nodal porosity; Eq. 54 adds M_s b */
+			const double Fw = (s->ps.exact ? 1.0 : n) * f->force_w[k] + Mw * s->gravity[c];
+			const double F = f->force[k] + (Ms + Mw) * s->gravity[c];
+			f->force_w[k] = Fw;
+			f->force[k] = F;
+			if (Ms > 0.0 && Mw > 0.0) {
+				const double a11 = Ms + Q * dt, a12 = -Q * dt, a22 = Mw + Q * dt;
+				const double r1 = Ms * f->v_s[k] + dt * (F - Fw), r2 = Mw * f->v_w[k] + dt * Fw;
+				const double det = a11 * a22 - a12 * a12;
+				f->v_s_star[k] = (r1 * a22 - a12 * r2) / det;
+				f->v_w_star[k] = (a11 * r2 - a12 * r1) / det;
+			} else if (Ms > 0.0) {
+				f->v_s_star[k] = f->v_s[k] + dt * F / Ms;
+			} else if (Mw > 0.0) {
+				f->v_w_star[k] = f->v_w[k] + dt * Fw / Mw;
+			}
 		}
 	}
-	boundary_apply(&s->grid, f->fix_s, f->v_s_star);
+	boundary_apply(&s->grid, f->fix_w, f->v_w_star);   /* (3e) */
+	boundary_apply(&s->grid, f->fix_s, f->v_s_star);   /* (4d) */
 }
 
 /* Step 6: velocity correction, Eqs. 64-68. With G = G_s + G_w and Eq. 65 substituted, Eq. 64
@@ -235,10 +247,11 @@ static void update_points(struct sim *s)
 	}
 }
 
-/* Water points that crossed a drained grid face have left the domain: they are removed and
- * their mass booked as outflow, so the water balance stays checkable (double point only: the
- * single-point water has no points of its own). Point probes following a removed point stop. */
-static void remove_drained_water(struct sim *s)
+/* Water points that crossed a grid face where water moves freely (a drained face, or open air)
+ * have left the domain: they are removed and their mass booked as outflow, so the water balance
+ * stays checkable (double point only: the single-point water has no points of its own). Point
+ * probes following a removed point stop. Crossing a wall is an error reported by step 1. */
+static void remove_outflowing_water(struct sim *s)
 {
 	struct particles *w = &s->water;
 	const struct grid *g = &s->grid;
@@ -249,7 +262,7 @@ static void remove_drained_water(struct sim *s)
 		double xi = (w->x[2 * q] - g->origin[0]) * g->inv_h, eta = (w->x[2 * q + 1] - g->origin[1]) * g->inv_h;
 		int face = xi < 0 ? FACE_LEFT : xi > g->cells[0] ? FACE_RIGHT :
 			   eta < 0 ? FACE_BOTTOM : eta > g->cells[1] ? FACE_TOP : -1;
-		if (face < 0 || bc[face].drainage != DRAINAGE_DRAINED)
+		if (face < 0 || bc[face].water != CONSTRAINT_FREE)
 			continue;
 		s->water_outflow_mass += w->mass[q];
 		for (int i = 0; i < s->spec->probe_count; i++) {
@@ -335,12 +348,11 @@ enum poro_status semi_implicit_step(struct sim *s)
 	map_soil_to_grid(s);                                    /* (2a-d) */
 	project_porosity_to_water(s);                           /* (8h-i) of the last step */
 	map_water_to_grid(s);                                   /* (2e-f) */
-	water_predictor(s);                                     /* (3) Eq. 53 */
-	soil_predictor(s);                                      /* (4) Eq. 52 */
+	predict_velocities(s);                                  /* (3)-(4) Eqs. 52-53 */
 	TRY(pressure_solve(s));                                 /* (5) Eq. 60 */
 	correct_velocities(s);                                  /* (6) Eqs. 64-65 */
 	update_points(s);                                       /* (7) */
-	remove_drained_water(s);
+	remove_outflowing_water(s);
 	TRY(update_soil_kinematics(s));                         /* (8) */
 	TRY(update_stress(s));                                  /* (10) */
 	s->time = (double)(s->step + 1) * s->dt;   /* no drift from summing dt */

@@ -64,6 +64,21 @@ int shape_1d(enum case_shape kind, double xi, idx_t cells, double inv_h, idx_t *
 	return quadratic_1d(xi, cells, inv_h, i0, w, dw);
 }
 
+int shape_weights_at(const struct grid *g, enum case_shape kind, const double x[2], idx_t *node0, double *w)
+{
+	const int S = shape_support(kind);
+	double wx[SHAPE_SUPPORT_MAX], wy[SHAPE_SUPPORT_MAX], d[SHAPE_SUPPORT_MAX];
+	idx_t i0, j0;
+	if (shape_1d(kind, (x[0] - g->origin[0]) * g->inv_h, g->cells[0], g->inv_h, &i0, wx, d) ||
+	    shape_1d(kind, (x[1] - g->origin[1]) * g->inv_h, g->cells[1], g->inv_h, &j0, wy, d))
+		return -1;
+	*node0 = grid_node(g, i0, j0);
+	for (int b = 0; b < S; b++)
+		for (int a = 0; a < S; a++)
+			w[a + b * S] = wx[a] * wy[b];
+	return 0;
+}
+
 enum poro_status shape_evaluate(const struct grid *g, enum case_shape kind, struct particles *p,
 				const char *set_name, struct poro_error *err)
 {

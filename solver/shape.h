@@ -25,6 +25,11 @@ int shape_support(enum case_shape kind);
  * Returns 0, or -1 if xi lies outside [0, cells]. */
 int shape_1d(enum case_shape kind, double xi, idx_t cells, double inv_h, idx_t *i0, double *w, double *dw);
 
+/* Weights of the support nodes at one location x (for surface quadrature points that are not
+ * material points). Writes the first support node and support^2 weights, node order i fastest.
+ * Returns 0, or -1 if x lies outside the grid. */
+int shape_weights_at(const struct grid *g, enum case_shape kind, const double x[2], idx_t *node0, double *w);
+
 /* Fills p->node0, p->w, p->dw for every point (the shape cache). Returns PORO_ESOLVER naming the
  * first point found outside the grid. */
 enum poro_status shape_evaluate(const struct grid *g, enum case_shape kind, struct particles *p,

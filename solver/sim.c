@@ -116,9 +116,10 @@ static enum poro_status allocate_scratch(struct sim *s)
 	s->water_vec = calloc(4 * nw, sizeof(double));
 	s->water_scalar = calloc(nw, sizeof(double));
 	s->water_coef = calloc(nw, sizeof(double));
+	s->cell_fill = calloc((size_t)s->grid.cell_count, sizeof(double));
 	s->probe_point = calloc((size_t)s->spec->probe_count + 1, sizeof(int));
 	if (!s->soil_grad || !s->soil_scalar || !s->soil_coef || !s->water_vec || !s->water_scalar ||
-	    !s->water_coef || !s->probe_point)
+	    !s->water_coef || !s->cell_fill || !s->probe_point)
 		return poro_error_set(&s->err, PORO_ENOMEM, "cannot allocate step workspaces");
 	return PORO_OK;
 }
@@ -144,7 +145,8 @@ static enum poro_status build(struct sim *s)
 	init_soil_state(s);
 	if ((st = init_water(s)) || (st = allocate_scratch(s)))
 		return st;
-	if ((st = pressure_system_init(&s->ps, &s->grid, s->soil.support, &s->err)))
+	if ((st = pressure_system_init(&s->ps, &s->grid, s->soil.support,
+					      c->formulation.pressure_projection, &s->err)))
 		return st;
 	boundary_mark(s);
 	loads_init(s);
@@ -190,6 +192,7 @@ void sim_destroy(struct sim **ps)
 	free(s->water_vec);
 	free(s->water_scalar);
 	free(s->water_coef);
+	free(s->cell_fill);
 	free(s->probe_point);
 	free(s);
 	*ps = NULL;

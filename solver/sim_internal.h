@@ -19,9 +19,12 @@
 
 /* The pressure Poisson system (000 Eqs. 60-61) on a fixed (2S-1)^2 node stencil. */
 struct pressure_system {
-	int radius;               /* S - 1: coupling reach in nodes */
+	int exact;                /* 1: projection matrix G^T M^-1 G; 0: Laplacian of Eq. 61 */
+	int radius;               /* coupling reach of the matrix in nodes: S - 1 (Eq. 61) or 2 (S - 1) */
 	int width;                /* 2 radius + 1 */
-	double *stencil;          /* [node_count * width^2] L_IJ by offset of J from I */
+	int g_radius, g_width;    /* reach of the gradient operators G: S - 1, and 2 g_radius + 1 */
+	double *stencil;          /* [node_count * width^2] matrix entries by offset of J from I */
+	double *grad_s, *grad_w;  /* [node_count * g_width^2 * 2] G_s, G_w (Eqs. 67-68) by offset */
 	idx_t *unknown;           /* [node_count] unknown number of a node, -1 if not an unknown */
 	idx_t *colptr, *rowidx;   /* CSC upper triangle of the reduced system */
 	double *values, *b, *x;
@@ -48,6 +51,7 @@ struct sim {
 	double *water_vec;            /* [4 n_water]: two 2-vectors */
 	double *water_scalar;         /* [n_water] */
 	double *water_coef;           /* [n_water] */
+	double *cell_fill;            /* [cell_count] volume of pressure-carrying points per cell, m^3/m */
 
 	double mapped_mass_s, mapped_mass_w; /* point mass sums mapped in the last P2G, kg/m */
 	double water_outflow_mass;    /* kg/m of water points that left through drained faces */
@@ -60,10 +64,12 @@ enum poro_status semi_implicit_step(struct sim *s);
 
 /* pressure.c: free-surface detection and the Poisson solve (000 §4.5 step 5). */
 enum poro_status pressure_system_init(struct pressure_system *ps, const struct grid *g, int support,
-				      struct poro_error *err);
+				      enum pressure_projection projection, struct poro_error *err);
 void pressure_system_release(struct pressure_system *ps);
 void pressure_mark_dirichlet(struct sim *s);
 enum poro_status pressure_solve(struct sim *s);
+void pressure_gradient_operators(struct sim *s);
+void pressure_apply_gradient(const struct sim *s, const double *G, const double *pressure, double *out);
 
 /* boundary.c: velocity constraints of the grid faces (000 §4.5 steps 3e, 4d, 6d). */
 void boundary_mark(struct sim *s);

@@ -1,0 +1,211 @@
+/*
+ * xie_leo_test.c - 000 §5.2 against Xie and Leo's large-strain closed form (issue item d).
+ *
+ * Table 2 column (E = 1 MPa, q = 200 kPa, h = 0.05 m, dt = 5e-4 s, to Tv = 2):
+ *  - small-strain elastic: top settlement within 3% of Eq. 87 at U = 0.25, 0.5, 0.75 and at the
+ *    end; RMS pore-pressure error (normalised by q) within 5% at U = 0.25, 0.5, 0.75 (Fig. 3a),
+ *    the analytical pressure taken at each water point's material depth;
+ *  - Hencky: the final settlement against Hencky's own closed form (with nu = 0 the Cauchy
+ *    stress is E ln(l) / l for stretch l, so the column settles to H (1 - l) with
+ *    E ln(l) / l = -q), and the difference to the small-strain run reported next to the
+ *    paper's "about 17%";
+ *  - soil and water mass conserved to 1e-12 at every step.
+ * The top surface is the top row of points plus half their current spacing (F_yy h / ppc / 2).
+ */
+#include <string.h>
+
+#include "../harness.h"
+#include "analytic.h"
+#include "case.h"
+#include "poro.h"
+
+#define CASES "tests/cases/"
+#define G 9.81
+
+struct column {
+	double H, q, k, rho_w, mv, E, spacing;
+};
+
+static struct column column_of(const struct case_spec *c)
+{
+	struct column col = {
+		.H = c->bodies[0].max[1] - c->bodies[0].min[1],
+		.q = -c->loads[0].traction[1],
+		.k = c->bodies[0].hydraulic_conductivity,
+		.rho_w = c->fluid.density,
+		.E = c->materials[0].youngs_modulus,
+		.spacing = c->grid.cell_size / c->bodies[0].particles_per_cell,
+	};
+	col.mv = 1.0 / col.E;     /* nu = 0 (Table 2) */
+	return col;
+}
+
+/* Tv at which the degree of consolidation is U (bisection on the monotone U(Tv)). */
+static double time_factor_for_degree(double U)
+{
+	double lo = 1e-6, hi = 10;
+	for (int i = 0; i < 200; i++) {
+		double mid = 0.5 * (lo + hi);
+		if (consolidation_degree(mid) < U)
+			lo = mid;
+		else
+			hi = mid;
+	}
+	return 0.5 * (lo + hi);
+}
+
+/* Settlement of the top surface: mean over the top row of its current top edge. */
+static double settlement(const struct sim *s, const struct column *col)
+{
+	const struct particles *p = sim_soil(s);
+	double sum = 0;
+	int count = 0;
+	for (idx_t q = 0; q < p->n; q++) {
+		if (p->x0[2 * q + 1] < col->H - col->spacing)
+			continue;
+		double top = p->x[2 * q + 1] + 0.5 * col->spacing * p->F[4 * q + 3];
+		sum += col->H - top;
+		count++;
+	}
+	return sum / count;
+}
+
+/* Material depth of a current height: interpolated along the soil points nearest x = x_ref. */
+static double material_depth(const struct sim *s, const struct column *col, double y)
+{
+	const struct particles *p = sim_soil(s);
+	double x_ref = p->x0[0];
+	double below_y = -1e9, below_y0 = 0, above_y = 1e9, above_y0 = col->H;
+	for (idx_t q = 0; q < p->n; q++) {
+		if (fabs(p->x0[2 * q] - x_ref) > 1e-9)
+			continue;
+		double yq = p->x[2 * q + 1], y0 = p->x0[2 * q + 1];
+		if (yq <= y && yq > below_y)
+			below_y = yq, below_y0 = y0;
+		if (yq > y && yq < above_y)
+			above_y = yq, above_y0 = y0;
+	}
+	if (below_y < -1e8)
+		return col->H - above_y0 * y / above_y;
+	if (above_y > 1e8)
+		return 0.0;    /* above the top row: inside the drained skin */
+	double y0 = below_y0 + (above_y0 - below_y0) * (y - below_y) / (above_y - below_y);
+	return col->H - y0;
+}
+
+static double pressure_rms(const struct sim *s, const struct column *col, double Tv, double surface)
+{
+	idx_t n = sim_pressure_point_count(s);
+	double *p = malloc(sizeof(double) * n), *x = malloc(sizeof(double) * 2 * n);
+	sim_pore_pressure(s, p, x);
+	double sum = 0;
+	long count = 0;
+	for (idx_t i = 0; i < n; i++) {
+		double y = x[2 * i + 1];
+		if (y > surface)
+			continue;          /* expelled water above the soil */
+		double e = p[i] - xie_leo_pressure(material_depth(s, col, y), col->H, col->mv, col->q, Tv);
+		sum += e * e;
+		count++;
+	}
+	free(p), free(x);
+	return sqrt(sum / count) / col->q;
+}
+
+struct run {
+	double settle[4], analytic[4], rms[3], drift;
+	int ok;
+};
+
+static struct run run_case(const char *file)
+{
+	struct run r = {0};
+	struct case_spec *c = NULL;
+	struct sim *s = NULL;
+	struct poro_error err = {0};
+	r.ok = !case_load_file(file, &c, &err) && !sim_create(&s, c, &err);
+	if (!r.ok) {
+		printf("INFO cannot run %s: %s\n", file, err.message);
+		return r;
+	}
+	struct column col = column_of(c);
+	const double U[3] = {0.25, 0.5, 0.75};
+	double Tv[4];
+	for (int i = 0; i < 3; i++)
+		Tv[i] = time_factor_for_degree(U[i]);
+	Tv[3] = time_factor(col.k, c->time.end, col.rho_w, G, col.mv, col.H);
+	double ms0 = sim_soil_mass(s), mw0 = sim_water_mass(s);
+	for (int i = 0; i < 4 && r.ok; i++) {
+		long target = lround(time_for_factor(col.k, Tv[i], col.rho_w, G, col.mv, col.H) / c->time.dt);
+		while (r.ok && sim_steps_taken(s) < target) {
+			if (sim_step(s)) {
+				printf("INFO %s failed: %s\n", file, sim_error(s)->message);
+				r.ok = 0;
+				break;
+			}
+			double ds = fabs(sim_soil_mass(s) - ms0) / ms0;
+			double dw = fabs(sim_water_mass(s) + sim_water_outflow_mass(s) - mw0) / mw0;
+			r.drift = fmax(r.drift, fmax(ds, dw));
+		}
+		r.settle[i] = settlement(s, &col);
+		r.analytic[i] = xie_leo_settlement(col.H, col.mv, col.q, Tv[i]);
+		if (i < 3)
+			r.rms[i] = pressure_rms(s, &col, Tv[i], col.H - r.settle[i]);
+	}
+	sim_destroy(&s);
+	case_destroy(&c);
+	return r;
+}
+
+/* Known failures, measured (docs/numerics.md): with the paper's Laplacian (Eq. 61) the column
+ * diverges within 60 steps of the sudden 200 kPa load; with the consistent projection it runs, but
+ * the top layer over-compresses in the initial shock (J 0.79, sigma' 230 kPa > q), consolidation
+ * lags Eq. 87 from U = 0.5 on and the run stops near Tv = 1.3 when a surface point's porosity
+ * reaches zero. The checks below state the requirement; those not met yet are marked. */
+int main(void)
+{
+	const char *labels[4] = {"U0.25", "U0.50", "U0.75", "end"};
+	struct run small = run_case(CASES "xie_leo.json");
+	CHECK_KNOWN_FAILURE(small.ok, "xie_leo_small_strain_runs_to_Tv2", "the run stopped before Tv = 2");
+	for (int i = 0; i < 4; i++) {
+		char name[96];
+		double rel = small.analytic[i] > 0 ? fabs(small.settle[i] - small.analytic[i]) / small.analytic[i] : 1;
+		printf("INFO xie-leo small strain %s: settlement %.5f m, Eq. 87 %.5f m, difference %.2f%%\n", labels[i],
+		       small.settle[i], small.analytic[i], 100 * rel);
+		snprintf(name, sizeof name, "xie_leo_settlement_within_3pct_%s", labels[i]);
+		if (i == 0)
+			CHECK(rel <= 0.03, name, "%.2f%%", 100 * rel);
+		else
+			CHECK_KNOWN_FAILURE(small.ok && rel <= 0.03, name, "%.2f%%", 100 * rel);
+	}
+	for (int i = 0; i < 3; i++) {
+		char name[96];
+		printf("INFO xie-leo small strain %s: pore pressure rms/q %.4f\n", labels[i], small.rms[i]);
+		snprintf(name, sizeof name, "xie_leo_pore_pressure_within_5pct_%s", labels[i]);
+		CHECK_KNOWN_FAILURE(small.rms[i] <= 0.05, name, "rms/q %.4f", small.rms[i]);
+	}
+	printf("INFO xie-leo small strain: max relative mass drift %.3e over the steps run\n", small.drift);
+	CHECK(small.drift <= 1e-12, "xie_leo_mass_conserved", "drift %.3e", small.drift);
+
+	struct run hencky = run_case(CASES "xie_leo_hencky.json");
+	CHECK_KNOWN_FAILURE(hencky.ok, "xie_leo_hencky_runs_to_Tv2", "the run stopped before Tv = 2");
+	/* Hencky's final state: E ln(l) / l = -q, by bisection on l in (0, 1) */
+	const double E = 1e6, q = 2e5, H = 1.0;
+	double lo = 0.5, hi = 1.0;
+	for (int i = 0; i < 200; i++) {
+		double l = 0.5 * (lo + hi);
+		if (E * log(l) / l < -q)
+			lo = l;
+		else
+			hi = l;
+	}
+	double l = 0.5 * (lo + hi);
+	double hencky_final = H * (1 - l) * consolidation_degree(2.0);
+	double rel = fabs(hencky.settle[3] - hencky_final) / hencky_final;
+	printf("INFO xie-leo hencky: settlement %.5f m when the run stopped, Hencky closed form at Tv = 2 %.5f m; "
+	       "small strain settles %.1f%% more (paper 000 §5.2: about 17%%)\n", hencky.settle[3], hencky_final,
+	       100 * (small.settle[3] / hencky.settle[3] - 1));
+	CHECK_KNOWN_FAILURE(hencky.ok && rel <= 0.03, "xie_leo_hencky_final_settlement_within_3pct", "%.2f%%", 100 * rel);
+	CHECK(hencky.drift <= 1e-12, "xie_leo_hencky_mass_conserved", "drift %.3e", hencky.drift);
+	HARNESS_EXIT();
+}
