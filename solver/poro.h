@@ -58,6 +58,14 @@ double sim_water_outflow_mass(const struct sim *s);
 void sim_grid_masses(const struct sim *s, double *grid_soil, double *grid_water, double *point_soil,
 		     double *point_water);
 
+/* Wall time spent in each phase of the steps taken so far (benchmarks). Phases, in step order:
+ * shape functions, particle-to-grid, predictors, pressure assembly, pressure factor-and-solve,
+ * correction, grid-to-particle, kinematics, stress update. */
+enum sim_phase { PHASE_SHAPE, PHASE_P2G, PHASE_PREDICT, PHASE_PRESSURE_ASSEMBLY, PHASE_PRESSURE_SOLVE,
+		 PHASE_CORRECT, PHASE_G2P, PHASE_KINEMATICS, PHASE_STRESS, PHASE_COUNT };
+const char *sim_phase_name(enum sim_phase phase);
+double sim_phase_seconds(const struct sim *s, enum sim_phase phase);
+
 /* Value of probe i of the case at the current state (units: Pa, m). */
 double sim_probe_value(const struct sim *s, int i);
 

@@ -314,6 +314,7 @@ enum poro_status pressure_solve(struct sim *s)
 {
 	struct pressure_system *ps = &s->ps;
 	const struct particles *p = &s->soil, *w = &s->water;
+	double t0 = sim_clock();
 	memset(ps->stencil, 0, sizeof(double) * (size_t)s->grid.node_count * ps->width * ps->width);
 	pressure_mark_dirichlet(s);
 	if (ps->exact) {
@@ -332,8 +333,11 @@ enum poro_status pressure_solve(struct sim *s)
 		assemble_rhs(s);
 	}
 	idx_t n = build_reduced_system(s);
+	double t1 = sim_clock();
+	s->phase_seconds[PHASE_PRESSURE_ASSEMBLY] += t1 - t0;
 	enum poro_status st = spd_solver_solve(ps->solver, n, ps->colptr, ps->rowidx, ps->values, ps->b,
 					       ps->x, &s->err);
+	s->phase_seconds[PHASE_PRESSURE_SOLVE] += sim_clock() - t1;
 	if (st)
 		return st;
 	for (idx_t I = 0; I < s->grid.node_count; I++)

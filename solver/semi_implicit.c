@@ -340,21 +340,40 @@ static enum poro_status update_stress(struct sim *s)
 	return status;
 }
 
+/* Runs one phase and adds its wall time to the phase's account. */
+#define PHASE(which, call)                                              \
+	do {                                                            \
+		double t0_ = sim_clock();                               \
+		call;                                                   \
+		s->phase_seconds[which] += sim_clock() - t0_;           \
+	} while (0)
+
 enum poro_status semi_implicit_step(struct sim *s)
 {
-	loads_gravity(s->spec, s->time + s->dt, s->gravity);   /* b^{t+1} */
-	TRY(evaluate_shape_functions(s));                       /* (1) */
-	reset_grid(s);
-	map_soil_to_grid(s);                                    /* (2a-d) */
-	project_porosity_to_water(s);                           /* (8h-i) of the last step */
-	map_water_to_grid(s);                                   /* (2e-f) */
-	predict_velocities(s);                                  /* (3)-(4) Eqs. 52-53 */
-	TRY(pressure_solve(s));                                 /* (5) Eq. 60 */
-	correct_velocities(s);                                  /* (6) Eqs. 64-65 */
-	update_points(s);                                       /* (7) */
-	remove_outflowing_water(s);
-	TRY(update_soil_kinematics(s));                         /* (8) */
-	TRY(update_stress(s));                                  /* (10) */
+	enum poro_status st = PORO_OK;
+	loads_gravity(s->spec, s->time + s->dt, s->gravity);                 /* b^{t+1} */
+	PHASE(PHASE_SHAPE, st = evaluate_shape_functions(s));                /* (1) */
+	if (st)
+		return st;
+	PHASE(PHASE_P2G, {
+		reset_grid(s);
+		map_soil_to_grid(s);                                         /* (2a-d) */
+		project_porosity_to_water(s);                                /* (8h-i) of the last step */
+		map_water_to_grid(s);                                        /* (2e-f) */
+	});
+	PHASE(PHASE_PREDICT, predict_velocities(s));                         /* (3)-(4) Eqs. 52-53 */
+	TRY(pressure_solve(s));                                              /* (5) Eq. 60 */
+	PHASE(PHASE_CORRECT, correct_velocities(s));                         /* (6) Eqs. 64-65 */
+	PHASE(PHASE_G2P, {
+		update_points(s);                                            /* (7) */
+		remove_outflowing_water(s);
+	});
+	PHASE(PHASE_KINEMATICS, st = update_soil_kinematics(s));            /* (8) */
+	if (st)
+		return st;
+	PHASE(PHASE_STRESS, st = update_stress(s));                          /* (10) */
+	if (st)
+		return st;
 	s->time = (double)(s->step + 1) * s->dt;   /* no drift from summing dt */
 	s->step++;
 	return PORO_OK;

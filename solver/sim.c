@@ -10,6 +10,7 @@
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
 
 #include "sim_internal.h"
 
@@ -215,6 +216,26 @@ enum poro_status sim_step(struct sim *s)
 					      "non-finite pressure or velocity at step %ld (t = %.6g s)", (long)q,
 					      s->water.x[2 * q], s->water.x[2 * q + 1], s->step, s->time);
 	return PORO_OK;
+}
+
+double sim_clock(void)
+{
+	struct timespec ts;
+	clock_gettime(CLOCK_MONOTONIC, &ts);
+	return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+const char *sim_phase_name(enum sim_phase phase)
+{
+	static const char *const names[PHASE_COUNT] = {
+		"shape functions", "particle-to-grid", "predictors", "pressure assembly",
+		"pressure factor+solve", "correction", "grid-to-particle", "kinematics", "stress update"};
+	return phase < PHASE_COUNT ? names[phase] : "unknown";
+}
+
+double sim_phase_seconds(const struct sim *s, enum sim_phase phase)
+{
+	return phase < PHASE_COUNT ? s->phase_seconds[phase] : 0.0;
 }
 
 int sim_done(const struct sim *s) { return s->step >= s->steps_total; }

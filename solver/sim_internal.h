@@ -55,9 +55,13 @@ struct sim {
 
 	double mapped_mass_s, mapped_mass_w; /* point mass sums mapped in the last P2G, kg/m */
 	double water_outflow_mass;    /* kg/m of water points that left through drained faces */
+	double phase_seconds[PHASE_COUNT]; /* wall time per phase, accumulated over steps */
 	int *probe_point;             /* [probe_count] tracked point of point probes, -1 otherwise */
 	struct poro_error err;
 };
+
+/* Monotonic wall clock, s; phases time themselves with it. */
+double sim_clock(void);
 
 /* semi_implicit.c: one step of 000 §4.5. */
 enum poro_status semi_implicit_step(struct sim *s);

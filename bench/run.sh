@@ -1,0 +1,11 @@
+#!/usr/bin/env bash
+# Speed figures for PoroMPM, printed and never asserted. One thread unless OMP_NUM_THREADS is set.
+set -u
+build=${1:-build}
+cd "$(dirname "$0")/.."
+export OMP_NUM_THREADS=${OMP_NUM_THREADS:-1}
+echo "machine: $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | sed 's/^ *//'), $(nproc) cores; OMP_NUM_THREADS=$OMP_NUM_THREADS"
+echo "== solver: 2-D elastic block, >= 100,000 soil points"
+"$build"/bench/solver_bench
+"$build"/bench/solver_bench --single-point
+"$build"/bench/solver_bench --projection consistent
