@@ -169,7 +169,14 @@ static void predict_velocities(struct sim *s)
 			const double F = f->force[k] + (Ms + Mw) * s->gravity[c];
 			f->force_w[k] = Fw;
 			f->force[k] = F;
-			if (Ms > 0.0 && Mw > 0.0) {
+			const int soil_fixed = f->fix_s[I] & (1 << c), water_fixed = f->fix_w[I] & (1 << c);
+			if (Ms > 0.0 && Mw > 0.0 && (soil_fixed || water_fixed)) {
+				/* a constrained phase keeps v* = 0 and takes the wall's reaction; the other
+				 * phase feels drag against it (the mixture equation would hand the
+				 * reaction to the free phase) */
+				f->v_s_star[k] = soil_fixed ? 0.0 : (Ms * f->v_s[k] + dt * (F - Fw)) / (Ms + Q * dt);
+				f->v_w_star[k] = water_fixed ? 0.0 : (Mw * f->v_w[k] + dt * Fw) / (Mw + Q * dt);
+			} else if (Ms > 0.0 && Mw > 0.0) {
 				const double a11 = Ms + Q * dt, a12 = -Q * dt, a22 = Mw + Q * dt;
 				const double r1 = Ms * f->v_s[k] + dt * (F - Fw), r2 = Mw * f->v_w[k] + dt * Fw;
 				const double det = a11 * a22 - a12 * a12;
@@ -236,8 +243,8 @@ static void update_points(struct sim *s)
 	if (s->spec->formulation.pore_pressure_smoothing) {
 		/* 7c with 9a: p^{t+1}_I = p^t_I + dp_I, p^t_I being the smoothed nodal pressure of
 		 * step 2 (Eq. 77's inner sum), interpolated back to the points (Eq. 77's outer sum) */
-		for (idx_t I = 0; I < s->grid.node_count; I++)
-			f->pressure[I] += f->dp[I];
+		for (idx_t I = 0; I < s->grid.node_count; I++)   /* free surface, drained faces: 0 */
+			f->pressure[I] = f->dirichlet[I] ? 0.0 : f->pressure[I] + f->dp[I];
 		g2p_scalar(&s->grid, &s->water, f->pressure, s->water.pressure);
 	} else {
 		/* unsmoothed: each point keeps its pressure and adds the interpolated increment */
