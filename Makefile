@@ -27,6 +27,7 @@ TEST_SRC   = $(wildcard tests/solver/*_test.c tests/verify/*_test.c)
 TEST_BIN   = $(TEST_SRC:%.c=$(BUILD)/%)
 BENCH_SRC  = $(wildcard bench/*_bench.c)
 BENCH_BIN  = $(BENCH_SRC:%.c=$(BUILD)/%)
+TOOLS      = $(BUILD)/terzaghi-error
 
 .PHONY: all deps run test verify bench clean build-all format
 .DEFAULT_GOAL := all
@@ -37,7 +38,7 @@ deps:
 all: deps
 	@$(MAKE) --no-print-directory build-all
 
-build-all: $(POROSOLVE) $(TEST_BIN) $(BENCH_BIN)
+build-all: $(POROSOLVE) $(TEST_BIN) $(BENCH_BIN) $(TOOLS)
 
 run: deps
 	@$(MAKE) --no-print-directory build-all
@@ -66,6 +67,11 @@ $(LIBPORO): $(SOLVER_OBJ)
 $(POROSOLVE): $(BUILD)/cli/poro_solve.o $(LIBPORO)
 	$(CC) $(LDFLAGS) $^ $(LDLIBS) -o $@
 
+$(BUILD)/terzaghi-error: $(BUILD)/tools/terzaghi_error.o $(LIBPORO)
+	$(CC) $(LDFLAGS) $^ $(LDLIBS) -o $@
+
+$(BUILD)/tools/terzaghi_error.o: tests/verify/analytic.h
+
 $(BUILD)/tests/%: $(BUILD)/tests/%.o $(LIBPORO)
 	$(CC) $(LDFLAGS) $^ $(LDLIBS) -o $@
 
@@ -73,7 +79,7 @@ $(BUILD)/bench/%: $(BUILD)/bench/%.o $(LIBPORO)
 	$(CC) $(LDFLAGS) $^ $(LDLIBS) -o $@
 
 format:
-	clang-format -i solver/*.c solver/*.h cli/*.c tests/*/*.c bench/*.c
+	clang-format -i solver/*.c solver/*.h cli/*.c tools/*.c tests/*/*.c bench/*.c
 
 clean:
 	rm -rf build build-san

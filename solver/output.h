@@ -15,7 +15,7 @@
  * atomically (write to a temporary name, rename), so a run killed at any moment leaves every
  * completed frame readable. Probes are buffered in memory and written at each frame and at close.
  *
- * This file is the only gateway to HDF5 (STYLE rule 5).
+ * HDF5 enters only through output*.c and results_read.c (STYLE rule 5).
  */
 #ifndef PORO_OUTPUT_H
 #define PORO_OUTPUT_H

@@ -22,7 +22,7 @@ fi
 
 crashed=0
 for prog in "${programs[@]}"; do
-	name=${prog##*/}
+	name=${prog%% *}; [ "$name" = bash ] && { name=${prog#bash }; name=${name%% *}; }; name=${name##*/}
 	echo "== $name" | tee -a "$log"
 	start=$(date +%s)
 	$prog > "$build/.one-test.txt" 2>&1

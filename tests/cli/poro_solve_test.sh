@@ -1,0 +1,140 @@
+#!/usr/bin/env bash
+# poro_solve_test.sh - drives the real build/poro-solve binary and checks its exit codes (error.h:
+# 0 ok, 2 invalid input, 3 solver failure, 4 I/O, 6 interrupted), its messages and what it leaves
+# on disk. Bad cases are derived from tests/cases/terzaghi.json with python3 JSON edits in a
+# temporary directory. Prints one line per check, "PASS name" or "FAIL name: why", like the C tests.
+# Runs in about 5 s (the longest part is a full Terzaghi run stopped by SIGTERM after ~1 s).
+#   bash tests/cli/poro_solve_test.sh BUILD_DIR      (from the repository root)
+set -u
+build=${1:-build}
+cd "$(dirname "$0")/../.."
+solve="$build/poro-solve"
+check_tool="$build/terzaghi-error"
+base=tests/cases/terzaghi.json
+tmp=$(mktemp -d)
+running=""
+trap '[ -n "$running" ] && kill "$running" 2>/dev/null; rm -rf "$tmp"' EXIT
+
+check() { # name, condition exit status ($?-style: 0 = holds), why
+	if [ "$2" -eq 0 ]; then echo "PASS $1"; else echo "FAIL $1: $3"; fi
+}
+
+# derive NAME PYTHON: writes $tmp/NAME.json, the base case c after the statement PYTHON
+derive() {
+	python3 - "$base" "$tmp/$1.json" "$2" <<'EOF'
+import json, sys
+c = json.load(open(sys.argv[1]))
+exec(sys.argv[3])
+json.dump(c, open(sys.argv[2], "w"), indent=1)
+EOF
+}
+
+# ---- invalid input: validate and run both exit 2, the message names the JSON pointer ----------
+
+head -c 300 "$base" > "$tmp/malformed.json"
+derive wrong_type 'c["grid"]["cell_size"] = "0.025"'
+derive out_of_range 'c["materials"][0]["poisson_ratio"] = 0.7'
+derive unknown_key 'c["time"]["dtt"] = 1e-4'
+derive body_outside_grid 'c["bodies"][0]["rectangle"]["max"] = [0.1, 1.5]'
+derive missing_material 'c["bodies"][0]["material"] = "clay"'
+
+bad_input() { # kind, JSON pointer the message must name
+	local kind=$1 pointer=$2 rc out="$tmp/out_$1"
+	"$solve" validate "$tmp/$kind.json" > /dev/null 2> "$tmp/err"
+	rc=$?
+	grep -q "^$pointer: " "$tmp/err"
+	check "validate_${kind}_exits_2_naming_pointer" $(( rc != 2 || $? != 0 )) \
+		"exit $rc, wanted 2 and '$pointer: ...' in: $(head -c 300 "$tmp/err")"
+	"$solve" run "$tmp/$kind.json" --out "$out" > /dev/null 2> "$tmp/err"
+	rc=$?
+	local left=0
+	[ -e "$out/result.h5" ] || [ -e "$out/result.xdmf" ] && left=1
+	grep -q "^$pointer: " "$tmp/err"
+	check "run_${kind}_exits_2_leaves_no_result" $(( rc != 2 || left || $? != 0 )) \
+		"exit $rc, result files left: $left, stderr: $(head -c 300 "$tmp/err")"
+}
+
+bad_input malformed "/"
+bad_input wrong_type "/grid/cell_size"
+bad_input out_of_range "/materials/0/poisson_ratio"
+bad_input unknown_key "/time/dtt"
+bad_input body_outside_grid "/bodies/0"
+bad_input missing_material "/bodies/0/material"
+
+# ---- a file that does not exist: exit 4 naming the path ---------------------------------------
+
+absent="$tmp/no_such_case.json"
+for cmd in validate run; do
+	if [ $cmd = run ]; then "$solve" run "$absent" --out "$tmp/out_absent" > /dev/null 2> "$tmp/err"
+	else "$solve" validate "$absent" > /dev/null 2> "$tmp/err"; fi
+	rc=$?
+	grep -qF "'$absent'" "$tmp/err"
+	check "${cmd}_missing_file_exits_4_naming_path" $(( rc != 4 || $? != 0 )) \
+		"exit $rc, stderr: $(head -c 300 "$tmp/err")"
+done
+
+# ---- usage errors ---------------------------------------------------------------------------------
+
+"$solve" > /dev/null 2> "$tmp/err"
+rc=$?
+grep -q usage "$tmp/err"
+check usage_no_arguments_exits_2 $(( rc != 2 || $? != 0 )) "exit $rc, stderr: $(head -c 200 "$tmp/err")"
+"$solve" run "$base" > /dev/null 2>&1
+rc=$?
+check usage_run_without_out_exits_2 $(( rc != 2 )) "exit $rc"
+
+# ---- every example case validates ------------------------------------------------------------------
+
+for f in tests/cases/*.json; do
+	"$solve" validate "$f" > /dev/null 2> "$tmp/err"
+	rc=$?
+	check "example_$(basename "$f" .json)_validates" "$rc" "exit $rc: $(head -c 300 "$tmp/err")"
+done
+
+# ---- a short successful run -----------------------------------------------------------------------
+
+derive short 'c["time"]["end"] = 0.01'
+out="$tmp/out_short"
+"$solve" run "$tmp/short.json" --out "$out" > "$tmp/stdout" 2> "$tmp/err"
+rc=$?
+check run_short_exits_0 "$rc" "exit $rc: $(head -c 300 "$tmp/err")"
+grep -q "us per material-point step" "$tmp/stdout"
+check run_short_prints_progress $? "no progress line in: $(head -c 300 "$tmp/stdout")"
+"$check_tool" "$out" > "$tmp/check" 2>&1
+rc=$?
+grep -q "^terzaghi: t = 0.01 s" "$tmp/check" && [ -f "$out/result.xdmf" ]
+check run_short_result_readable $(( rc != 0 || $? != 0 )) "terzaghi-error exit $rc: $(cat "$tmp/check")"
+
+# ---- a solver failure: the column falls out of the grid through its free bottom ------------------
+
+derive falls 'c["boundaries"]["bottom"] = {"soil": "free", "water": "free"}
+c["gravity"]["acceleration"] = [0.0, -2000.0]
+c["time"]["end"] = 0.05'
+"$solve" run "$tmp/falls.json" --out "$tmp/out_falls" > /dev/null 2> "$tmp/err"
+rc=$?
+grep -qE "point [0-9]+ .*\(-?[0-9.e+-]+, -?[0-9.e+-]+\)" "$tmp/err"
+check solver_failure_exits_3_naming_point_and_position $(( rc != 3 || $? != 0 )) \
+	"exit $rc, stderr: $(head -c 300 "$tmp/err")"
+
+# ---- SIGTERM during a full-length run: exit 6, the frames written so far readable ------------------
+
+out="$tmp/out_term"
+"$solve" run "$base" --out "$out" > "$tmp/stdout" 2> "$tmp/err" &
+running=$!
+# the first progress line comes after 1 s of wall time, when the signal handlers are installed
+for _ in $(seq 100); do
+	grep -q "^step " "$tmp/stdout" && break
+	kill -0 "$running" 2>/dev/null || break
+	sleep 0.1
+done
+kill -TERM "$running" 2>/dev/null
+wait "$running"
+rc=$?
+running=""
+check sigterm_exits_6 $(( rc != 6 )) "exit $rc (0: finished before the signal), stderr: $(head -c 300 "$tmp/err")"
+"$check_tool" "$out" > "$tmp/check" 2>&1
+tool_rc=$?
+h5dump -a /run/status "$out/result.h5" > "$tmp/h5" 2>&1
+grep -q '"failed"' "$tmp/h5"
+check sigterm_result_readable $(( tool_rc != 0 || $? != 0 )) \
+	"terzaghi-error exit $tool_rc: $(cat "$tmp/check"); h5dump: $(head -c 200 "$tmp/h5")"
