@@ -26,7 +26,9 @@ enum pressure_projection { PROJECTION_LAPLACIAN, PROJECTION_CONSISTENT };
 
 enum material_model { MODEL_LINEAR_ELASTIC, MODEL_HENCKY };
 
-enum permeability_law { PERMEABILITY_CONSTANT, PERMEABILITY_KOZENY_CARMAN };
+/* constant; Kozeny-Carman k = C1 n^3 / (1 - n)^2 (000 step 8g); volume_ratio k = k0 V / V0, Xie and
+ * Leo's assumption that k falls with (1 + e) as m_v does, under which 000 Eq. 87 holds. */
+enum permeability_law { PERMEABILITY_CONSTANT, PERMEABILITY_KOZENY_CARMAN, PERMEABILITY_VOLUME_RATIO };
 
 /* Velocity constraint of one phase on a grid face: free, slip (normal component zero: a roller),
  * fixed (both components zero). */
@@ -76,7 +78,8 @@ struct case_body {
 	int particles_per_cell;           /* points per cell per direction (2 means 2x2) */
 	double porosity;                  /* initial porosity n0, 0 < n0 < 1 */
 	double hydraulic_conductivity;    /* k0, m/s, > 0 */
-	enum permeability_law permeability_law; /* "constant" (default) or "kozeny_carman" (000 step 8g) */
+	enum permeability_law permeability_law; /* "constant" (default), "kozeny_carman" (000 step 8g) or
+						   "volume_ratio" (k = k0 V/V0, Xie and Leo 2004) */
 };
 
 struct case_time_function {

@@ -285,7 +285,7 @@ static void remove_outflowing_water(struct sim *s)
 }
 
 /* Step 8: MUSL displacement increment (8a), deformation gradient increment (8b-c), volume,
- * Jacobian and porosity (8d-f), Kozeny-Carman conductivity (8g). */
+ * Jacobian and porosity (8d-f), conductivity: Kozeny-Carman (8g) or proportional to J. */
 static enum poro_status update_soil_kinematics(struct sim *s)
 {
 	struct particles *p = &s->soil;
@@ -317,6 +317,8 @@ static enum poro_status update_soil_kinematics(struct sim *s)
 			double n0 = p->porosity0[q];
 			double C1 = body->hydraulic_conductivity * (1.0 - n0) * (1.0 - n0) / (n0 * n0 * n0);
 			p->conductivity[q] = C1 * n * n * n / ((1.0 - n) * (1.0 - n));
+		} else if (body->permeability_law == PERMEABILITY_VOLUME_RATIO) {
+			p->conductivity[q] = body->hydraulic_conductivity * J;   /* (1 + e)/(1 + e0) = J */
 		}
 	}
 	if (bad >= 0)
