@@ -4,7 +4,7 @@ set -u
 build=${1:-build}
 cd "$(dirname "$0")/.."
 export OMP_NUM_THREADS=${OMP_NUM_THREADS:-1}
-echo "machine: $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | sed 's/^ *//'), $(nproc) cores; OMP_NUM_THREADS=$OMP_NUM_THREADS"
+echo "machine: $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | sed 's/^ *//'), $(nproc --all) cores; OMP_NUM_THREADS=$OMP_NUM_THREADS"
 echo "== solver: 2-D elastic block, >= 100,000 soil points"
 "$build"/bench/solver_bench
 "$build"/bench/solver_bench --single-point

@@ -276,7 +276,9 @@ static idx_t build_reduced_system(struct sim *s)
 	struct grid_fields *f = &s->f;
 	struct pressure_system *ps = &s->ps;
 	const int W = ps->width, R = ps->radius, centre = R + R * W;
-	const int remap = s->spec->formulation.pore_pressure_smoothing;
+	/* the consistent projection solves for the multiplier p^t + dp itself, so its boundary
+	 * value must be reached through dp */
+	const int remap = s->spec->formulation.pore_pressure_smoothing && !ps->exact;
 	idx_t n = 0;
 	for (idx_t I = 0; I < g->node_count; I++) {
 		int active = ps->stencil[(size_t)I * W * W + centre] > 0.0;

@@ -244,7 +244,7 @@ static void update_points(struct sim *s)
 		/* 7c with 9a: p^{t+1}_I = p^t_I + dp_I, p^t_I being the smoothed nodal pressure of
 		 * step 2 (Eq. 77's inner sum), interpolated back to the points (Eq. 77's outer sum) */
 		for (idx_t I = 0; I < s->grid.node_count; I++)   /* free surface, drained faces: 0 */
-			f->pressure[I] = f->dirichlet[I] ? 0.0 : f->pressure[I] + f->dp[I];
+			f->pressure[I] = f->dirichlet[I] && !s->ps.exact ? 0.0 : f->pressure[I] + f->dp[I];
 		g2p_scalar(&s->grid, &s->water, f->pressure, s->water.pressure);
 	} else {
 		/* unsmoothed: each point keeps its pressure and adds the interpolated increment */

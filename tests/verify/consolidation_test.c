@@ -142,12 +142,15 @@ static void check_terzaghi(const char *label, const char *file, const char *phas
 	printf("INFO terzaghi %s max relative mass drift %.3e, grid-vs-point mass %.3e\n", label, drift, grid_err);
 	CHECK(ok && drift <= MASS_TOL && grid_err <= MASS_TOL, name, "drift %.3e grid %.3e", drift, grid_err);
 
-	/* the soil predictor is explicit: its stable step shrinks with h, so halve dt with h */
-	ok = run_column(file, 0.0125, 0.5e-4, phases, Tv, 4, fine, &drift_fine, &grid_fine);
+	/* the soil predictor is explicit: its stable step shrinks with h, so halve dt with h. The
+	 * comparison uses Tv = 0.1 and 0.2, where the pressure gradients are steepest and the
+	 * discretisation error largest; running on to Tv = 1 at h/2 would cost 8 times the coarse
+	 * run for the least informative part. */
+	ok = run_column(file, 0.0125, 0.5e-4, phases, Tv, 2, fine, &drift_fine, &grid_fine);
 	double coarse_mean = 0, fine_mean = 0;
-	for (int i = 0; i < 4; i++) {
+	for (int i = 0; i < 2; i++) {
 		printf("INFO terzaghi %s h=0.0125 Tv=%.1f rms/q=%.5f\n", label, Tv[i], fine[i]);
-		coarse_mean += rms[i] / 4, fine_mean += fine[i] / 4;
+		coarse_mean += rms[i] / 2, fine_mean += fine[i] / 2;
 	}
 	snprintf(name, sizeof name, "terzaghi_%s_error_falls_with_h", label);
 	if (convergence_known_to_fail)   /* an error floor near 0.1% of q, see docs/numerics.md */
@@ -209,18 +212,20 @@ static void check_consistent_projection(void)
 	double rms[4] = {0}, fine[4] = {0}, drift, grid_err;
 	consistent_projection = 1;
 	int ok = run_column(CASES "terzaghi_single_point.json", 0, 0, NULL, Tv, 4, rms, &drift, &grid_err) &&
-		 run_column(CASES "terzaghi_single_point.json", 0.0125, 0.5e-4, NULL, Tv, 4, fine, &drift, &grid_err);
+		 run_column(CASES "terzaghi_single_point.json", 0.0125, 0.5e-4, NULL, Tv, 2, fine, &drift, &grid_err);
 	consistent_projection = 0;
 	double worst = 0, coarse_mean = 0, fine_mean = 0;
 	for (int i = 0; i < 4; i++) {
-		printf("INFO terzaghi single_point consistent projection Tv=%.1f rms/q=%.5f (h) %.5f (h/2)\n", Tv[i],
-		       rms[i], fine[i]);
+		printf("INFO terzaghi single_point consistent projection Tv=%.1f rms/q=%.5f (h)\n", Tv[i], rms[i]);
 		worst = fmax(worst, rms[i]);
-		coarse_mean += rms[i] / 4, fine_mean += fine[i] / 4;
+	}
+	for (int i = 0; i < 2; i++) {
+		printf("INFO terzaghi single_point consistent projection Tv=%.1f rms/q=%.5f (h/2)\n", Tv[i], fine[i]);
+		coarse_mean += rms[i] / 2, fine_mean += fine[i] / 2;
 	}
 	CHECK(ok && worst <= 0.02, "terzaghi_consistent_projection_rms_below_2pct", "worst rms/q %.5f", worst);
 	CHECK(ok && fine_mean < coarse_mean, "terzaghi_consistent_projection_error_falls_with_h",
-	      "mean rms/q %.5f (h) vs %.5f (h/2)", coarse_mean, fine_mean);
+	      "mean rms/q at Tv 0.1-0.2 %.5f (h) vs %.5f (h/2)", coarse_mean, fine_mean);
 }
 
 /* With an argument, runs only the named group (double_point, single_point, drained, low_k). */
