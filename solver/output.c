@@ -36,6 +36,8 @@
 #include <time.h>
 #include <unistd.h>
 
+#include "hdf5_reason.h"
+
 #include "output_xdmf.h"
 
 #define OUTPUT_PATH_MAX 512             /* object paths inside result.h5 */
@@ -72,35 +74,6 @@ struct output {
 };
 
 /* ---- errors --------------------------------------------------------------------------------- */
-
-/* HDF5's reason for the first failure since the last report: its innermost (most specific)
- * description. Recorded by an automatic error handler, because the cleanup calls that follow a
- * failure clear HDF5's error stack before the failure can be reported. */
-static char hdf5_reason[256];
-
-/* The innermost description, shortened: a system call's failure becomes its strerror text, which
- * HDF5 embeds as "error message = '...'" among a timestamp, addresses and sizes. */
-static herr_t innermost(unsigned n, const H5E_error2_t *e, void *data)
-{
-	if (n != 0 || !e->desc)
-		return 0;
-	const char *key = "error message = '";
-	const char *from = strstr(e->desc, key);
-	from = from ? from + strlen(key) : e->desc;
-	size_t len = strcspn(from, from == e->desc ? "\n" : "'\n");
-	if (len >= sizeof hdf5_reason)
-		len = sizeof hdf5_reason - 1;
-	snprintf(data, sizeof hdf5_reason, "%.*s", (int)len, from);
-	return 0;
-}
-
-/* Installed with H5Eset_auto2 in place of HDF5's printer: the library never prints. */
-static herr_t record_reason(hid_t stack, void *data)
-{
-	if (!hdf5_reason[0])
-		H5Ewalk2(stack, H5E_WALK_UPWARD, innermost, hdf5_reason);
-	return 0;
-}
 
 static void reason_clear(void)
 {
@@ -576,7 +549,7 @@ enum poro_status output_create(struct output **out, const char *dir, const char 
 	if (!S_ISDIR(sb.st_mode))
 		return poro_error_set(err, PORO_EIO, "cannot create results in '%s': not a directory", dir);
 	/* the library never prints: HDF5's error reports are recorded for h5_fail() instead */
-	H5Eset_auto2(H5E_DEFAULT, record_reason, NULL);
+	H5Eset_auto2(H5E_DEFAULT, hdf5_record_reason, NULL);
 	reason_clear();
 
 	struct output *o = calloc(1, sizeof *o);

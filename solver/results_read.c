@@ -22,6 +22,8 @@
 #include <string.h>
 #include <sys/stat.h>
 
+#include "hdf5_reason.h"
+
 #include "output_xdmf.h"
 
 #define RESULTS_PATH_MAX 512        /* object paths inside result.h5 */
@@ -36,30 +38,6 @@ struct results {
 
 /* ---- errors ------------------------------------------------------------------------------------ */
 
-/* HDF5's innermost description of the first failure since the call began. */
-static char hdf5_reason[256];
-
-/* A system call's failure is shortened to its strerror text, which HDF5 embeds as
- * "error message = '...'" among names, flags and addresses (as output.c does). */
-static herr_t innermost(unsigned n, const H5E_error2_t *e, void *data)
-{
-	if (n != 0 || !e->desc)
-		return 0;
-	const char *key = "error message = '";
-	const char *from = strstr(e->desc, key);
-	from = from ? from + strlen(key) : e->desc;
-	int len = (int)strcspn(from, from == e->desc ? "\n" : "'\n");
-	snprintf(data, sizeof hdf5_reason, "%.*s", len, from);
-	return 0;
-}
-
-static herr_t record_reason(hid_t stack, void *data)
-{
-	if (!hdf5_reason[0])
-		H5Ewalk2(stack, H5E_WALK_UPWARD, innermost, hdf5_reason);
-	return 0;
-}
-
 /* The caller's HDF5 error handler, put aside for one public call. */
 struct handler {
 	H5E_auto2_t func;
@@ -70,7 +48,7 @@ static struct handler quiet_begin(void)
 {
 	struct handler h = {NULL, NULL};
 	H5Eget_auto2(H5E_DEFAULT, &h.func, &h.data);
-	H5Eset_auto2(H5E_DEFAULT, record_reason, NULL);
+	H5Eset_auto2(H5E_DEFAULT, hdf5_record_reason, NULL);
 	hdf5_reason[0] = '\0';
 	return h;
 }
