@@ -29,7 +29,8 @@ struct grid_fields {
 	double *mass_s;          /* M_sI, Eq. 44, kg/m */
 	double *mass_w;          /* M_wI, Eq. 50 */
 	double *mass_w_points;   /* sum S m_wp: water mass with one dof, for Eq. 77 weights */
-	double *mass_w_v;        /* sum S rho_w V0 (Eq. 51 denominator) */
+	double *mass_w_v;        /* sum S V_wp: water-point volume at the node (Eq. 50 without n rho_w) */
+	double *volume_s;        /* sum S V_sp: soil-point volume at the node */
 	double *v_s, *v_w;       /* v^t, then v^{t+1} after the correction (step 6) */
 	double *v_s_old, *v_w_old; /* v^t kept for the FLIP increment (step 7b) */
 	double *v_s_star, *v_w_star; /* intermediate velocities, Eqs. 52-53 */

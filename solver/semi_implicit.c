@@ -54,7 +54,7 @@ static void reset_grid(struct sim *s)
 {
 	const size_t n = (size_t)s->grid.node_count;
 	struct grid_fields *f = &s->f;
-	double *scalars[] = {f->mass_s, f->mass_w, f->mass_w_points, f->mass_w_v, f->porosity,
+	double *scalars[] = {f->mass_s, f->mass_w, f->mass_w_points, f->mass_w_v, f->volume_s, f->porosity,
 			     f->conductivity, f->pressure, f->dp, f->rhs};
 	double *vectors[] = {f->v_s, f->v_w, f->v_s_old, f->v_w_old, f->v_s_star, f->v_w_star,
 			     f->force_w, f->force, f->correction_s, f->correction_w, f->du_s};
@@ -83,6 +83,7 @@ static void map_soil_to_grid(struct sim *s)
 		s->mapped_mass_s += p->mass[q];
 	p2g_vector(&s->grid, p, p->mass, p->v, f->v_s);
 	p2g_scalar(&s->grid, p, p->mass, p->porosity, f->porosity);
+	p2g_scalar(&s->grid, p, NULL, p->volume, f->volume_s);
 	p2g_scalar(&s->grid, p, p->mass, p->conductivity, f->conductivity);
 	idx_t nodes = s->grid.node_count;
 	normalise(nodes, f->v_s, 2, f->mass_s);
@@ -140,6 +141,18 @@ static void map_water_to_grid(struct sim *s)
  * a 2x2 system per node and component with a positive determinant M_s M_w + Q dt (M_s + M_w).
  * It is still local (no global system), and equals the paper's predictor as Q dt / M_w -> 0.
  * Nodal forces: F_w = F_w^ext - F_w^int (Eqs. 56-57), F = F^ext - F^int (Eqs. 54-55). */
+/* Share of a node's water that lies in the soil: soil-point volume over water-point volume, at
+ * most 1. Eqs. 46-47 give nodes at the soil surface the soil's porosity and conductivity however
+ * little soil reaches them, so Eq. 58 would drag the free water expelled above the soil as if it
+ * filled pores: that layer then resists drainage like soil and consolidation stalls (the
+ * double-point Xie-Leo column stopped near U = 0.5). Single point: always 1. */
+static double soil_fraction(const struct grid_fields *f, idx_t I)
+{
+	if (!(f->mass_w_v[I] > 0.0))
+		return 1.0;
+	return fmin(1.0, f->volume_s[I] / f->mass_w_v[I]);
+}
+
 static void predict_velocities(struct sim *s)
 {
 	struct grid_fields *f = &s->f;
@@ -159,9 +172,9 @@ static void predict_velocities(struct sim *s)
 	loads_add_tractions(s, s->time + dt, f->force);
 	for (idx_t I = 0; I < s->grid.node_count; I++) {
 		const double n = f->porosity[I], Ms = f->mass_s[I], Mw = f->mass_w[I];
-		double Q = 0.0;            /* Eq. 58; no drag where there is no soil */
+		double Q = 0.0;            /* Eq. 58, for the water that lies in the soil */
 		if (Ms > 0.0 && Mw > 0.0 && f->conductivity[I] > 0.0)
-			Q = CONDUCTIVITY_GRAVITY * n / f->conductivity[I] * Mw;
+			Q = CONDUCTIVITY_GRAVITY * n / f->conductivity[I] * Mw * soil_fraction(f, I);
 		for (int c = 0; c < 2; c++) {
 			const int k = 2 * I + c;
 			/* Eq. 56 is M_wI b; Eq. 57 carries the nodal porosity; Eq. 54 adds M_s b */
