@@ -20,7 +20,10 @@
  *    within 400 steps; keeping unsmoothed point pressures (p += sum S dp) and smoothing only for
  *    the forces leaves a mode the forces cannot see, which grows at k = 1e-9 m/s. With smoothing
  *    switched off the points keep their pressure and add the interpolated increment;
- *  - the two predictors are solved together at each node (see predict_velocities);
+ *  - the two predictors are solved together at each node, and a wall-constrained phase takes
+ *    the wall's reaction itself (see predict_velocities);
+ *  - the drag of Eq. 58 is scaled by the node's soil share, so free water standing above the
+ *    soil is not dragged as if it filled pores (see soil_fraction);
  *  - in the Laplacian L (Eq. 61) the porosity stays inside the point sum so that L is symmetric
  *    (see pressure.c).
  * Single point: the water set rides on the soil points (same positions, volumes, porosity), so
