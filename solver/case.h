@@ -23,6 +23,9 @@ enum case_shape { SHAPE_LINEAR, SHAPE_QUADRATIC_BSPLINE };
 /* The matrix of the pressure solve: the Laplacian of 000 Eq. 61, or the projection G^T M^-1 G
  * consistent with the velocity correction (docs/numerics.md compares them). */
 enum pressure_projection { PROJECTION_LAPLACIAN, PROJECTION_CONSISTENT };
+/* Soil-phase stabilisation (000 §4.4.2): none, or F-bar with the node-wise averaged volume
+ * change (Eqs. 79-80). */
+enum soil_stabilisation { STABILISATION_NONE, STABILISATION_FBAR };
 
 enum material_model { MODEL_LINEAR_ELASTIC, MODEL_HENCKY };
 
@@ -51,6 +54,7 @@ struct case_formulation {
 	int pore_pressure_smoothing;      /* node-wise smoothing, 000 Eq. 77; default true */
 	double flip_fraction;             /* 1 = pure FLIP (default), 0 = PIC; velocity update blend */
 	enum pressure_projection pressure_projection; /* "laplacian" (default) or "consistent" */
+	enum soil_stabilisation soil_stabilisation;   /* "none" (default) or "fbar" */
 };
 
 struct case_grid {

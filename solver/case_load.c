@@ -55,6 +55,7 @@ static const char *const scheme_names[] = { "semi_implicit", NULL };
 static const char *const phases_names[] = { "double_point", "single_point", NULL };
 static const char *const shape_names[] = { "linear", "quadratic_bspline", NULL };
 static const char *const projection_names[] = { "laplacian", "consistent", NULL };
+static const char *const stabilisation_names[] = { "none", "fbar", NULL };
 static const char *const model_names[] = { "linear_elastic", "hencky", NULL };
 static const char *const permeability_law_names[] = { "constant", "kozeny_carman", "volume_ratio", NULL };
 static const char *const constraint_names[] = { "free", "slip", "fixed", NULL };
@@ -71,7 +72,7 @@ static const char *const top_keys[] = { "schema", "title", "formulation", "grid"
 					"fluid", "gravity", "boundaries", "loads", "time", "output",
 					"probes", NULL };
 static const char *const formulation_keys[] = { "scheme", "phases", "shape", "pore_pressure_smoothing",
-						"flip_fraction", "pressure_projection", NULL };
+						"flip_fraction", "pressure_projection", "soil_stabilisation", NULL };
 static const char *const grid_keys[] = { "origin", "extent", "cell_size", NULL };
 static const char *const material_keys[] = { "name", "model", "density", "youngs_modulus",
 					     "poisson_ratio", NULL };
@@ -239,6 +240,8 @@ static void read_formulation(struct case_reader *r, const json_t *root, struct c
 	case_read_number(r, o, p, "flip_fraction", CASE_OPTIONAL, &FRACTION, &f->flip_fraction);
 	f->pressure_projection = read_choice_or(r, o, p, "pressure_projection", CASE_OPTIONAL, projection_names,
 						f->pressure_projection);
+	f->soil_stabilisation = read_choice_or(r, o, p, "soil_stabilisation", CASE_OPTIONAL, stabilisation_names,
+					       f->soil_stabilisation);
 }
 
 /* Checks that extent[d] is a whole number, at least GRID_CELLS_MIN, of cells. */

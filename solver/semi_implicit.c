@@ -300,6 +300,33 @@ static void remove_outflowing_water(struct sim *s)
 	}
 }
 
+/* Steps 9b-9d, standard F-bar (000 Eqs. 79-80): each soil point's deformation-gradient increment
+ * is scaled so that its volume change equals the node-wise average dJbar = sum_I S_Ip
+ * (sum_q S_Iq m_q dJ_q / M_sI), i.e. dFbar = (dJbar / dJ)^(1/2) dF in 2-D. The scaled increment
+ * serves the volume, porosity and stress updates alike, so the points' volumes stay those the
+ * stress sees. The nodal pressure array is free after step 7 and holds the nodal average. */
+static void apply_fbar(struct sim *s)
+{
+	struct particles *p = &s->soil;
+	struct grid_fields *f = &s->f;
+	double *dJ = s->soil_scalar, *dJbar = s->soil_coef;
+	for (idx_t q = 0; q < p->n; q++) {
+		const double *dF = p->dF + 4 * q;
+		dJ[q] = dF[0] * dF[3] - dF[1] * dF[2];
+	}
+	memset(f->pressure, 0, sizeof(double) * (size_t)s->grid.node_count);
+	p2g_scalar(&s->grid, p, p->mass, dJ, f->pressure);
+	normalise(s->grid.node_count, f->pressure, 1, f->mass_s);
+	g2p_scalar(&s->grid, p, f->pressure, dJbar);
+	for (idx_t q = 0; q < p->n; q++) {
+		if (!(dJ[q] > 0.0) || !(dJbar[q] > 0.0))
+			continue;   /* an inverted point is reported by the caller */
+		const double scale = sqrt(dJbar[q] / dJ[q]);
+		for (int c = 0; c < 4; c++)
+			p->dF[4 * q + c] *= scale;
+	}
+}
+
 /* Step 8: MUSL displacement increment (8a), deformation gradient increment (8b-c), volume,
  * Jacobian and porosity (8d-f), conductivity: Kozeny-Carman (8g) or proportional to J. */
 static enum poro_status update_soil_kinematics(struct sim *s)
@@ -312,10 +339,14 @@ static enum poro_status update_soil_kinematics(struct sim *s)
 			f->du_s[2 * I + c] = f->mass_s[I] > 0.0 ? s->dt * f->du_s[2 * I + c] / f->mass_s[I] : 0.0;
 	boundary_apply(&s->grid, f->fix_s, f->du_s);
 	g2p_vector_gradient(&s->grid, p, f->du_s, p->dF);
+	for (idx_t q = 0; q < p->n; q++) {
+		p->dF[4 * q] += 1.0, p->dF[4 * q + 3] += 1.0;
+	}
+	if (s->spec->formulation.soil_stabilisation == STABILISATION_FBAR)
+		apply_fbar(s);
 	idx_t bad = -1;
 	for (idx_t q = 0; q < p->n; q++) {
 		double *dF = p->dF + 4 * q, *F = p->F + 4 * q;
-		dF[0] += 1.0, dF[3] += 1.0;
 		double dJ = dF[0] * dF[3] - dF[1] * dF[2];
 		double F0 = dF[0] * F[0] + dF[1] * F[2], F1 = dF[0] * F[1] + dF[1] * F[3];
 		double F2 = dF[2] * F[0] + dF[3] * F[2], F3 = dF[2] * F[1] + dF[3] * F[3];
