@@ -115,13 +115,13 @@ static void map_water_to_grid(struct sim *s)
 	struct particles *w = &s->water;
 	struct grid_fields *f = &s->f;
 	const idx_t nodes = s->grid.node_count;
-	for (idx_t q = 0; q < w->n; q++)    /* n rho_w V: constant n0 rho_w V0 in double point (Eq. 37) */
+	s->mapped_mass_w = 0.0;
+	for (idx_t q = 0; q < w->n; q++) {  /* n rho_w V: constant n0 rho_w V0 in double point (Eq. 37) */
 		w->mass[q] = w->porosity[q] * s->rho_w * w->volume[q];
+		s->mapped_mass_w += w->mass[q];
+	}
 	p2g_scalar(&s->grid, w, NULL, w->volume, f->mass_w_v);
 	p2g_scalar(&s->grid, w, NULL, w->mass, f->mass_w_points);
-	s->mapped_mass_w = 0.0;
-	for (idx_t q = 0; q < w->n; q++)
-		s->mapped_mass_w += w->mass[q];
 	p2g_vector(&s->grid, w, w->mass, w->v, f->v_w);
 	p2g_scalar(&s->grid, w, w->mass, w->pressure, f->pressure);
 	normalise(nodes, f->v_w, 2, f->mass_w_points);

@@ -193,7 +193,8 @@ enum poro_status spd_solver_solve(struct spd_solver *s, idx_t n, const idx_t *co
 	if (n > s->n_max || nnz > s->nnz_max)
 		return poro_error_set(err, PORO_ESOLVER, "pressure system of %ld unknowns, %ld entries exceeds "
 				      "its capacity (%ld, %ld)", (long)n, (long)nnz, (long)s->n_max, (long)s->nnz_max);
-	if (same_pattern(s, n, colptr, rowidx)) {
+	const int same = same_pattern(s, n, colptr, rowidx);
+	if (same) {
 		if (preconditioned_cg(s, n, colptr, rowidx, values, b, x)) {
 			s->pcg_solves++;
 			return PORO_OK;
@@ -206,7 +207,7 @@ enum poro_status spd_solver_solve(struct spd_solver *s, idx_t n, const idx_t *co
 	memcpy(A->x, values, sizeof(double) * (size_t)nnz);
 	A->sorted = 1;
 	A->packed = 1;
-	if (!same_pattern(s, n, colptr, rowidx)) {
+	if (!same) {
 		cholmod_free_factor(&s->L, &s->cm);
 		s->L = cholmod_analyze(A, &s->cm);
 		if (!s->L)

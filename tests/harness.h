@@ -63,6 +63,22 @@ static inline double rnd(double lo, double hi)
 		fflush(stdout);                                                   \
 	} while (0)
 
+/* A whole file as a NUL-terminated string the caller frees, or NULL if it cannot be read. */
+static inline char *harness_read_file(const char *path)
+{
+	FILE *f = fopen(path, "rb");
+	if (!f)
+		return NULL;
+	fseek(f, 0, SEEK_END);
+	long n = ftell(f);
+	fseek(f, 0, SEEK_SET);
+	char *s = n >= 0 ? malloc((size_t)n + 1) : NULL;
+	if (s)
+		s[fread(s, 1, (size_t)n, f)] = '\0';
+	fclose(f);
+	return s;
+}
+
 #define HARNESS_EXIT() return harness_failed_count ? 1 : 0
 
 #endif

@@ -145,21 +145,6 @@ static char *big_case_json(void)
 	return s;
 }
 
-static char *read_text(const char *path)
-{
-	FILE *f = fopen(path, "rb");
-	if (!f)
-		return NULL;
-	fseek(f, 0, SEEK_END);
-	long n = ftell(f);
-	fseek(f, 0, SEEK_SET);
-	char *s = malloc((size_t)n + 1);
-	size_t got = fread(s, 1, (size_t)n, f);
-	s[got] = '\0';
-	fclose(f);
-	return s;
-}
-
 static int count_of(const char *text, const char *needle)
 {
 	int c = 0;
@@ -476,7 +461,7 @@ static int xdmf_frames(const char *dir)
 {
 	char path[128];
 	snprintf(path, sizeof path, "%s/result.xdmf", dir);
-	char *x = read_text(path);
+	char *x = harness_read_file(path);
 	if (!x)
 		return -1;
 	int frames = count_of(x, "CollectionType=\"Spatial\"");
@@ -525,7 +510,7 @@ static void check_xdmf(const char *dir, int frames, int double_point, const char
 	int listed = xdmf_frames(dir);
 	CHECK(listed == frames, name, "%d", listed);
 	snprintf(path, sizeof path, "%s/result.xdmf", dir);
-	char *x = read_text(path);
+	char *x = harness_read_file(path);
 	if (!x)
 		return;
 	int grids = frames * (double_point ? 2 : 1) + frames + 1;

@@ -70,22 +70,6 @@ static char *join(char *buf, size_t size, const char *dir, const char *name)
 	return buf;
 }
 
-/* A whole text file, NULL-terminated, or NULL. */
-static char *slurp(const char *path)
-{
-	FILE *f = fopen(path, "rb");
-	if (!f)
-		return NULL;
-	fseek(f, 0, SEEK_END);
-	long n = ftell(f);
-	fseek(f, 0, SEEK_SET);
-	char *s = n >= 0 ? malloc((size_t)n + 1) : NULL;
-	if (s)
-		s[fread(s, 1, (size_t)n, f)] = '\0';
-	fclose(f);
-	return s;
-}
-
 static int spill(const char *path, const char *text)
 {
 	FILE *f = fopen(path, "wb");
@@ -247,11 +231,11 @@ static void check_running_file(const char *dir)
 	int ok = !case_load_string(json, &c, &err) && !sim_create(&s, c, &err) &&
 		 !output_create(&o, dir, json, "results_read_test", 0, NULL, NULL, &err);
 	struct output_frame fr = {.time = 0.0, .step = 0, .soil = ok ? sim_soil(s) : NULL};
-	ok = ok && !output_frame_write(o, &fr, &err) && (one_frame = slurp(join(xdmf, sizeof xdmf, dir, "result.xdmf")));
+	ok = ok && !output_frame_write(o, &fr, &err) && (one_frame = harness_read_file(join(xdmf, sizeof xdmf, dir, "result.xdmf")));
 	fr.time = 1.7e-3, fr.step = 17;
 	ok = ok && !output_frame_write(o, &fr, &err);
 	output_destroy(&o);
-	char *two_frames = ok ? slurp(xdmf) : NULL;
+	char *two_frames = ok ? harness_read_file(xdmf) : NULL;
 	ok = ok && two_frames && !spill(xdmf, one_frame);
 	CHECK(ok, "running_file_prepared", "%s", err.message);
 
