@@ -29,6 +29,17 @@ BENCH_SRC  = $(wildcard bench/*_bench.c)
 BENCH_BIN  = $(BENCH_SRC:%.c=$(BUILD)/%)
 TOOLS      = $(BUILD)/terzaghi-error
 
+# The service (docs/service.md): server, worker, user CLI and load generator. Each external library
+# enters through one file: libmicrohttpd (server/http.c), SQLite (server/store*.c), libcurl
+# (client/http_client.c), libcrypto (common/digest.c).
+COMMON_OBJ = $(patsubst %.c,$(BUILD)/%.o,$(wildcard common/*.c))
+CLIENT_OBJ = $(patsubst %.c,$(BUILD)/%.o,$(wildcard client/*.c))
+SERVER_OBJ = $(patsubst %.c,$(BUILD)/%.o,$(wildcard server/*.c))
+WORKER_OBJ = $(patsubst %.c,$(BUILD)/%.o,$(wildcard worker/*.c))
+SVC_LIBS   = -ljansson -lcrypto -lpthread
+SERVICE    = $(if $(SERVER_OBJ),$(BUILD)/poro-server) $(if $(WORKER_OBJ),$(BUILD)/poro-worker) \
+	     $(if $(CLIENT_OBJ),$(BUILD)/poro $(BUILD)/poro-load)
+
 .PHONY: all deps run test verify bench clean build-all format
 .DEFAULT_GOAL := all
 
@@ -38,7 +49,7 @@ deps:
 all: deps
 	@$(MAKE) --no-print-directory build-all
 
-build-all: $(POROSOLVE) $(TEST_BIN) $(BENCH_BIN) $(TOOLS)
+build-all: $(POROSOLVE) $(TEST_BIN) $(BENCH_BIN) $(TOOLS) $(SERVICE)
 
 run: deps
 	@$(MAKE) --no-print-directory build-all
@@ -56,9 +67,9 @@ bench: deps
 	@$(MAKE) --no-print-directory build-all
 	@bash bench/run.sh $(BUILD)
 
-$(BUILD)/%.o: %.c $(wildcard solver/*.h tests/*.h)
+$(BUILD)/%.o: %.c $(wildcard solver/*.h tests/*.h common/*.h client/*.h server/*.h worker/*.h)
 	@mkdir -p $(dir $@)
-	$(CC) $(CPPFLAGS) $(CFLAGS) -c $< -o $@
+	$(CC) $(CPPFLAGS) -Icommon -Iclient $(CFLAGS) -c $< -o $@
 
 $(LIBPORO): $(SOLVER_OBJ)
 	@rm -f $@
@@ -78,8 +89,20 @@ $(BUILD)/tests/%: $(BUILD)/tests/%.o $(LIBPORO)
 $(BUILD)/bench/%: $(BUILD)/bench/%.o $(LIBPORO)
 	$(CC) $(LDFLAGS) $^ $(LDLIBS) -o $@
 
+$(BUILD)/poro-server: $(SERVER_OBJ) $(COMMON_OBJ) $(LIBPORO)
+	$(CC) $(LDFLAGS) $^ $(LDLIBS) -lmicrohttpd -lsqlite3 $(SVC_LIBS) -o $@
+
+$(BUILD)/poro-worker: $(WORKER_OBJ) $(CLIENT_OBJ) $(COMMON_OBJ)
+	$(CC) $(LDFLAGS) $^ -lcurl $(SVC_LIBS) -o $@
+
+$(BUILD)/poro: $(BUILD)/cli/poro.o $(CLIENT_OBJ) $(COMMON_OBJ)
+	$(CC) $(LDFLAGS) $^ -lcurl $(SVC_LIBS) -lm -o $@
+
+$(BUILD)/poro-load: $(BUILD)/bench/poro_load.o $(CLIENT_OBJ) $(COMMON_OBJ)
+	$(CC) $(LDFLAGS) $^ -lcurl $(SVC_LIBS) -lm -o $@
+
 format:
-	clang-format -i solver/*.c solver/*.h cli/*.c tools/*.c tests/*/*.c bench/*.c
+	clang-format -i solver/*.c solver/*.h cli/*.c tools/*.c tests/*/*.c bench/*.c common/*.[ch] $(wildcard client/*.[ch] server/*.[ch] worker/*.[ch])
 
 clean:
 	rm -rf build build-san

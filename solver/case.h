@@ -55,6 +55,7 @@ struct case_formulation {
 	double flip_fraction;             /* 1 = pure FLIP (default), 0 = PIC; velocity update blend */
 	enum pressure_projection pressure_projection; /* "laplacian" (default) or "consistent" */
 	enum soil_stabilisation soil_stabilisation;   /* "none" (default) or "fbar" */
+	int drag_in_correction;           /* drag also in the velocity correction (phase_coupling.h); default false */
 };
 
 struct case_grid {

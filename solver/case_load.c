@@ -72,7 +72,8 @@ static const char *const top_keys[] = { "schema", "title", "formulation", "grid"
 					"fluid", "gravity", "boundaries", "loads", "time", "output",
 					"probes", NULL };
 static const char *const formulation_keys[] = { "scheme", "phases", "shape", "pore_pressure_smoothing",
-						"flip_fraction", "pressure_projection", "soil_stabilisation", NULL };
+						"flip_fraction", "pressure_projection", "soil_stabilisation",
+						"drag_in_correction", NULL };
 static const char *const grid_keys[] = { "origin", "extent", "cell_size", NULL };
 static const char *const material_keys[] = { "name", "model", "density", "youngs_modulus",
 					     "poisson_ratio", NULL };
@@ -237,6 +238,7 @@ static void read_formulation(struct case_reader *r, const json_t *root, struct c
 	f->phases = read_choice_or(r, o, p, "phases", CASE_OPTIONAL, phases_names, f->phases);
 	f->shape = read_choice_or(r, o, p, "shape", CASE_OPTIONAL, shape_names, f->shape);
 	case_read_bool(r, o, p, "pore_pressure_smoothing", CASE_OPTIONAL, &f->pore_pressure_smoothing);
+	case_read_bool(r, o, p, "drag_in_correction", CASE_OPTIONAL, &f->drag_in_correction);
 	case_read_number(r, o, p, "flip_fraction", CASE_OPTIONAL, &FRACTION, &f->flip_fraction);
 	f->pressure_projection = read_choice_or(r, o, p, "pressure_projection", CASE_OPTIONAL, projection_names,
 						f->pressure_projection);
@@ -637,6 +639,7 @@ static void set_defaults(struct case_spec *c)
 	c->formulation.shape = SHAPE_QUADRATIC_BSPLINE;
 	c->formulation.pore_pressure_smoothing = 1;
 	c->formulation.flip_fraction = 1;
+	c->formulation.drag_in_correction = 0;
 	c->fluid.density = DEFAULT_FLUID_DENSITY;
 	c->fluid.bulk_modulus = DEFAULT_FLUID_BULK_MODULUS;
 	c->gravity.acceleration[0] = 0;

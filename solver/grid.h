@@ -36,6 +36,8 @@ struct grid_fields {
 	double *v_s_star, *v_w_star; /* intermediate velocities, Eqs. 52-53 */
 	double *porosity;        /* n_I, Eq. 46 (1 where there is no soil) */
 	double *conductivity;    /* k_I, Eq. 47, m/s */
+	double *drag_dt;         /* Q_I dt, Eq. 58 times the step, kg/m: the drag of both velocity updates */
+	double *mobility_ratio;  /* mixture mobility with drag over that without (pressure.c), 1 without drag */
 	double *pressure;        /* p^t_I: water-mass-weighted projection of point pressures, tension + */
 	double *dp;              /* p^{t+1} - p^t, Eq. 60 */
 	double *force_w;         /* F_w^ext - F_w^int, Eqs. 56-57, N/m */

@@ -30,6 +30,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "phase_coupling.h"
 #include "sim_internal.h"
 #include "transfer.h"
 
@@ -211,42 +212,77 @@ void pressure_apply_gradient(const struct sim *s, const double *G, const double 
 	}
 }
 
-/* A = sum over phases and free velocity components of G^T M^-1 G, and b = -sum G^T v* / dt:
- * the projection that makes the corrected velocities satisfy -G^T v = 0 exactly. */
-static void assemble_exact_projection(struct sim *s, const double *G, const double *M, const unsigned char *fix,
-				      const double *v_star)
+/* The drag the correction applies at node I (zero when formulation.drag_in_correction is off). */
+static double correction_drag(const struct sim *s, idx_t I)
+{
+	return s->spec->formulation.drag_in_correction ? s->f.drag_dt[I] : 0.0;
+}
+
+/* A = sum over nodes and velocity components of [G_s; G_w]^T K^-1 [G_s; G_w], K^-1 the phase
+ * coupling of the correction (phase_coupling.h; without drag, G_s^T M_s^-1 G_s + G_w^T M_w^-1 G_w),
+ * and b = -sum (G_s^T v_s* + G_w^T v_w*) / dt over the free components: the projection that
+ * makes the corrected velocities satisfy -G^T v = 0 exactly. A is SPD because K^-1 is. */
+static void assemble_exact_projection(struct sim *s)
 {
 	const struct grid *g = &s->grid;
+	const struct grid_fields *f = &s->f;
 	struct pressure_system *ps = &s->ps;
 	const int Wg = ps->g_width, Rg = ps->g_radius, W = ps->width, R = ps->radius;
 	for (idx_t I = 0; I < g->node_count; I++) {
-		if (!(M[I] > 0.0))
-			continue;
 		const idx_t i = I % g->nodes[0], j = I / g->nodes[0];
-		const double *row = G + (size_t)I * Wg * Wg * 2;
+		const double *gs = ps->grad_s + (size_t)I * Wg * Wg * 2, *gw = ps->grad_w + (size_t)I * Wg * Wg * 2;
 		for (int c = 0; c < 2; c++) {
-			if (fix[I] & (1 << c))
+			const struct phase_coupling K = phase_coupling_inverse(f->mass_s[I], f->mass_w[I],
+									       correction_drag(s, I), f->fix_s[I] & (1 << c),
+									       f->fix_w[I] & (1 << c));
+			if (K.ss == 0.0 && K.ww == 0.0)
 				continue;
-			const double inv_m = 1.0 / M[I], vc = v_star[2 * I + c];
+			const double vs = K.ss > 0.0 ? f->v_s_star[2 * I + c] : 0.0;
+			const double vw = K.ww > 0.0 ? f->v_w_star[2 * I + c] : 0.0;
 			for (int a = 0; a < Wg * Wg; a++) {
 				const int ax = a % Wg - Rg, ay = a / Wg - Rg;
 				if (i + ax < 0 || i + ax >= g->nodes[0] || j + ay < 0 || j + ay >= g->nodes[1])
 					continue;
-				const double gk = row[2 * a + c];
-				if (gk == 0.0)
+				const double gsa = gs[2 * a + c], gwa = gw[2 * a + c];
+				if (gsa == 0.0 && gwa == 0.0)
 					continue;
-				const idx_t K = I + ax + ay * g->nodes[0];
-				s->f.rhs[K] -= gk * vc / s->dt;
-				double *arow = ps->stencil + (size_t)K * W * W;
+				const idx_t Ka = I + ax + ay * g->nodes[0];
+				s->f.rhs[Ka] -= (gsa * vs + gwa * vw) / s->dt;
+				/* row a of K^-1 [G_s; G_w] contracted with the column of each b */
+				const double ts = K.ss * gsa + K.sw * gwa, tw = K.sw * gsa + K.ww * gwa;
+				double *arow = ps->stencil + (size_t)Ka * W * W;
 				for (int b = 0; b < Wg * Wg; b++) {
 					const int bx = b % Wg - Rg, by = b / Wg - Rg;
 					if (i + bx < 0 || i + bx >= g->nodes[0] || j + by < 0 || j + by >= g->nodes[1])
 						continue;
-					arow[(bx - ax + R) + (by - ay + R) * W] += gk * row[2 * b + c] * inv_m;
+					arow[(bx - ax + R) + (by - ay + R) * W] += ts * gs[2 * b + c] + tw * gw[2 * b + c];
 				}
 			}
 		}
 	}
+}
+
+/* The Laplacian of Eq. 61 weights the soil by (1 - n) / rho_s and the water by n / rho_w: the
+ * mobilities of decoupled phases. With drag in the correction, the mixture's mobility at a node
+ * is (1-n, n) K^-1 (1-n, n)^T (phase_coupling.h), which tends to 1 / (M_s + M_w) as k -> 0. Each
+ * point's coefficient is scaled by the ratio of the two, interpolated from the nodes. */
+static void scale_by_mobility_ratio(struct sim *s, const struct particles *p, double *coef, double *scratch)
+{
+	struct grid_fields *f = &s->f;
+	if (!s->spec->formulation.drag_in_correction)
+		return;
+	for (idx_t I = 0; I < s->grid.node_count; I++) {
+		const double n = f->porosity[I], Ms = f->mass_s[I], Mw = f->mass_w[I];
+		f->mobility_ratio[I] = 1.0;
+		if (!(Ms > 0.0 && Mw > 0.0))
+			continue;
+		const struct phase_coupling K = phase_coupling_inverse(Ms, Mw, f->drag_dt[I], 0, 0);
+		const double with_drag = (1 - n) * (1 - n) * K.ss + 2 * n * (1 - n) * K.sw + n * n * K.ww;
+		f->mobility_ratio[I] = with_drag / ((1 - n) * (1 - n) / Ms + n * n / Mw);
+	}
+	g2p_scalar(&s->grid, p, f->mobility_ratio, scratch);
+	for (idx_t q = 0; q < p->n; q++)
+		coef[q] *= scratch[q];
 }
 
 /* Right-hand side (D_s v_s* + D_w v_w*) / dt, Eqs. 62-63 evaluated through the point divergences. */
@@ -327,8 +363,7 @@ enum poro_status pressure_solve(struct sim *s)
 	pressure_mark_dirichlet(s);
 	if (ps->exact) {
 		memset(s->f.rhs, 0, sizeof(double) * (size_t)s->grid.node_count);
-		assemble_exact_projection(s, ps->grad_s, s->f.mass_s, s->f.fix_s, s->f.v_s_star);
-		assemble_exact_projection(s, ps->grad_w, s->f.mass_w, s->f.fix_w, s->f.v_w_star);
+		assemble_exact_projection(s);
 	} else {
 		for (idx_t q = 0; q < p->n; q++) {
 			const double rho_s = s->materials[s->spec->bodies[p->body[q]].material].density;
@@ -336,6 +371,8 @@ enum poro_status pressure_solve(struct sim *s)
 		}
 		for (idx_t q = 0; q < w->n; q++)
 			s->water_coef[q] = w->volume[q] * w->porosity[q] / s->rho_w;
+		scale_by_mobility_ratio(s, p, s->soil_coef, s->soil_scalar);
+		scale_by_mobility_ratio(s, w, s->water_coef, s->water_scalar);
 		assemble_laplacian(s, p, s->soil_coef);
 		assemble_laplacian(s, w, s->water_coef);
 		assemble_rhs(s);

@@ -32,6 +32,7 @@
 #include <math.h>
 #include <string.h>
 
+#include "phase_coupling.h"
 #include "shape.h"
 #include "sim_internal.h"
 #include "transfer.h"
@@ -185,37 +186,35 @@ static void predict_velocities(struct sim *s)
 			const double F = f->force[k] + (Ms + Mw) * s->gravity[c];
 			f->force_w[k] = Fw;
 			f->force[k] = F;
-			const int soil_fixed = f->fix_s[I] & (1 << c), water_fixed = f->fix_w[I] & (1 << c);
-			if (Ms > 0.0 && Mw > 0.0 && (soil_fixed || water_fixed)) {
-				/* a constrained phase keeps v* = 0 and takes the wall's reaction; the other
-				 * phase feels drag against it (the mixture equation would hand the
-				 * reaction to the free phase) */
-				f->v_s_star[k] = soil_fixed ? 0.0 : (Ms * f->v_s[k] + dt * (F - Fw)) / (Ms + Q * dt);
-				f->v_w_star[k] = water_fixed ? 0.0 : (Mw * f->v_w[k] + dt * Fw) / (Mw + Q * dt);
-			} else if (Ms > 0.0 && Mw > 0.0) {
-				const double a11 = Ms + Q * dt, a12 = -Q * dt, a22 = Mw + Q * dt;
-				const double r1 = Ms * f->v_s[k] + dt * (F - Fw), r2 = Mw * f->v_w[k] + dt * Fw;
-				const double det = a11 * a22 - a12 * a12;
-				f->v_s_star[k] = (r1 * a22 - a12 * r2) / det;
-				f->v_w_star[k] = (a11 * r2 - a12 * r1) / det;
-			} else if (Ms > 0.0) {
-				f->v_s_star[k] = f->v_s[k] + dt * F / Ms;
-			} else if (Mw > 0.0) {
-				f->v_w_star[k] = f->v_w[k] + dt * Fw / Mw;
-			}
+			/* the 2x2 system of the comment above (phase_coupling.h); a constrained phase
+			 * keeps v* = 0 and takes the wall's reaction, the other feels drag against it
+			 * (the mixture equation would hand the reaction to the free phase) */
+			const struct phase_coupling K = phase_coupling_inverse(Ms, Mw, Q * dt, f->fix_s[I] & (1 << c),
+									       f->fix_w[I] & (1 << c));
+			const double r_s = Ms * f->v_s[k] + dt * (F - Fw), r_w = Mw * f->v_w[k] + dt * Fw;
+			f->v_s_star[k] = K.ss * r_s + K.sw * r_w;
+			f->v_w_star[k] = K.sw * r_s + K.ww * r_w;
 		}
+		f->drag_dt[I] = Q * dt;
 	}
 	boundary_apply(&s->grid, f->fix_w, f->v_w_star);   /* (3e) */
 	boundary_apply(&s->grid, f->fix_s, f->v_s_star);   /* (4d) */
 }
 
-/* Step 6: velocity correction, Eqs. 64-68. With G = G_s + G_w and Eq. 65 substituted, Eq. 64
- * reduces to M_s (v_s^{t+1} - v_s*) = dt G_s dp, which is how it is evaluated. */
+/* Step 6: velocity correction, Eqs. 64-68. The pressure increment pushes the soil with
+ * f_s = dt G_s dp and the water with f_w = dt G_w dp (G = G_s + G_w, so their sum is Eq. 64).
+ * The paper's Eq. 65 moves the water by f_w / M_w alone, without drag: each step the phases then
+ * separate by dt^2 grad(dp) / rho whatever the permeability, which at k = 1e-9 m/s is a million
+ * times the Darcy flux and drains a column far faster than it can (docs/numerics.md). With
+ * formulation.drag_in_correction the correction takes the drag at the new
+ * velocities, as the predictors do (phase_coupling.h), and the pressure matrix agrees with it.
+ * Off by default while its effect on the verification cases is measured (docs/numerics.md). */
 static void correct_velocities(struct sim *s)
 {
 	struct grid_fields *f = &s->f;
 	const struct grid *g = &s->grid;
 	double *grad_s = s->soil_grad, *grad_w = s->water_vec;
+	const int drag = s->spec->formulation.drag_in_correction;
 	g2p_scalar_gradient(g, &s->soil, f->dp, grad_s);
 	p2g_vector(g, &s->soil, s->soil.volume, grad_s, f->correction_s);
 	g2p_scalar_gradient(g, &s->water, f->dp, grad_w);
@@ -224,8 +223,12 @@ static void correct_velocities(struct sim *s)
 		const double n = f->porosity[I];
 		for (int c = 0; c < 2; c++) {
 			const int k = 2 * I + c;
-			f->v_w[k] = f->mass_w[I] > 0.0 ? f->v_w_star[k] + s->dt * n * f->correction_w[k] / f->mass_w[I] : 0.0;
-			f->v_s[k] = f->mass_s[I] > 0.0 ? f->v_s_star[k] + s->dt * (1.0 - n) * f->correction_s[k] / f->mass_s[I] : 0.0;
+			const struct phase_coupling K = phase_coupling_inverse(
+				f->mass_s[I], f->mass_w[I], drag ? f->drag_dt[I] : 0.0, f->fix_s[I] & (1 << c),
+				f->fix_w[I] & (1 << c));
+			const double f_s = s->dt * (1.0 - n) * f->correction_s[k], f_w = s->dt * n * f->correction_w[k];
+			f->v_s[k] = f->mass_s[I] > 0.0 ? f->v_s_star[k] + K.ss * f_s + K.sw * f_w : 0.0;
+			f->v_w[k] = f->mass_w[I] > 0.0 ? f->v_w_star[k] + K.sw * f_s + K.ww * f_w : 0.0;
 		}
 	}
 	boundary_apply(g, f->fix_w, f->v_w);

@@ -15,7 +15,7 @@ log="$build/test-output.txt"
 programs=()
 if [ "$mode" = test ]; then
 	for t in "$build"/tests/solver/*_test "$build"/tests/verify/*_test; do [ -x "$t" ] && programs+=("$t"); done
-	for t in tests/cli/*_test.sh; do [ -f "$t" ] && programs+=("bash $t $build"); done
+	for t in tests/cli/*_test.sh tests/service/*_test.sh; do [ -f "$t" ] && programs+=("bash $t $build"); done
 else
 	for t in "$build"/tests/verify/*_test; do [ -x "$t" ] && programs+=("$t"); done
 fi
