@@ -150,6 +150,9 @@ struct case_spec {
 	} output;
 	int probe_count;
 	struct case_probe *probes;
+	struct {
+		double interval;          /* s of simulated time between checkpoints; 0 = none (key absent) */
+	} checkpoint;
 	char *json;                       /* the case as given, NUL-terminated */
 };
 
@@ -158,6 +161,13 @@ struct case_spec {
 enum poro_status case_load_file(const char *path, struct case_spec **out, struct poro_error *err);
 enum poro_status case_load_string(const char *json, struct case_spec **out, struct poro_error *err);
 void case_destroy(struct case_spec **c);
+
+/* Compares two case texts as JSON values: key order, white space and the spelling of numbers
+ * (2, 2.0, 2e0) do not matter. Returns 0 when equal; 1 when they differ, with the JSON pointer
+ * of the first difference in where[size] ("/" for the whole document); -1 when either text is
+ * not JSON (where names which: "first" or "second"). Implemented with the case loader's JSON
+ * reader (case_json.c). */
+int case_json_difference(const char *a, const char *b, char *where, size_t size);
 
 /* Value of a time function at time t (dimensionless factor). */
 double case_time_function_value(const struct case_time_function *f, double t);

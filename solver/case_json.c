@@ -9,6 +9,9 @@
  * A JSON "integer" is any number with no fractional part (2 and 2.0 alike), as in JSON Schema.
  * Strings from the document that appear in messages are cut short and control characters are
  * replaced by '?' (case_quote), so that every problem stays one line.
+ *
+ * It also compares two case texts as JSON values (case_json_difference in case.h), which is how a
+ * checkpoint is matched to the case a resumed run is given.
  */
 #include "case_json.h"
 
@@ -16,7 +19,10 @@
 #include <math.h>
 #include <stdarg.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
+
+#include "case.h"
 
 #define PROBLEM_MAX 1024            /* longest single problem message */
 
@@ -392,4 +398,97 @@ const json_t *case_read_array(struct case_reader *r, const json_t *obj, const ch
 const json_t *case_array_item(const json_t *array, size_t index)
 {
 	return json_array_get(array, index);
+}
+
+/* ---- comparing two cases (case.h: case_json_difference) --------------------------------------- */
+
+static int compare_keys(const void *a, const void *b)
+{
+	return strcmp(*(const char *const *)a, *(const char *const *)b);
+}
+
+/* The members of a and b, sorted, without repeats, in keys[json_object_size(a) + size(b)];
+ * returns their number. */
+static size_t union_keys(const json_t *a, const json_t *b, const char **keys)
+{
+	size_t n = 0, unique = 0;
+	const char *key;
+	json_t *v;
+	json_object_foreach((json_t *)a, key, v)
+		keys[n++] = key;
+	json_object_foreach((json_t *)b, key, v)
+		keys[n++] = key;
+	qsort(keys, n, sizeof *keys, compare_keys);
+	for (size_t i = 0; i < n; i++)
+		if (unique == 0 || strcmp(keys[unique - 1], keys[i]))
+			keys[unique++] = keys[i];
+	return unique;
+}
+
+/* 0 when a and b are equal JSON values; otherwise 1 with the pointer of the first difference (in
+ * sorted key order) in where[CASE_POINTER_MAX], or -1 when out of memory. Numbers compare by value. */
+static int value_difference(const json_t *a, const json_t *b, const char *base, char *where)
+{
+	if (json_is_number(a) && json_is_number(b) && json_number_value(a) == json_number_value(b))
+		return 0;
+	if (json_typeof(a) != json_typeof(b) || (!json_is_object(a) && !json_is_array(a))) {
+		if (json_equal((json_t *)a, (json_t *)b))
+			return 0;
+		snprintf(where, CASE_POINTER_MAX, "%s", base[0] ? base : "/");
+		return 1;
+	}
+	char pointer[CASE_POINTER_MAX];
+	if (json_is_array(a)) {
+		size_t na = json_array_size(a), nb = json_array_size(b);
+		for (size_t i = 0; i < na && i < nb; i++) {
+			case_pointer_index(pointer, base, i);
+			int d = value_difference(json_array_get(a, i), json_array_get(b, i), pointer, where);
+			if (d)
+				return d;
+		}
+		if (na == nb)
+			return 0;
+		case_pointer_index(where, base, na < nb ? na : nb);   /* the first item only one has */
+		return 1;
+	}
+	const char **keys = malloc((json_object_size(a) + json_object_size(b) + 1) * sizeof *keys);
+	if (!keys)
+		return -1;
+	size_t n = union_keys(a, b, keys);
+	int d = 0;
+	for (size_t i = 0; i < n && !d; i++) {
+		const json_t *va = json_object_get(a, keys[i]), *vb = json_object_get(b, keys[i]);
+		case_pointer_key(pointer, base, keys[i]);
+		if (!va || !vb) {
+			snprintf(where, CASE_POINTER_MAX, "%s", pointer);
+			d = 1;
+		} else {
+			d = value_difference(va, vb, pointer, where);
+		}
+	}
+	free(keys);
+	return d;
+}
+
+int case_json_difference(const char *a, const char *b, char *where, size_t size)
+{
+	char pointer[CASE_POINTER_MAX] = "/";
+	json_t *ja = json_loads(a ? a : "", JSON_DECODE_ANY, NULL);
+	json_t *jb = json_loads(b ? b : "", JSON_DECODE_ANY, NULL);
+	int d;
+	if (!ja || !jb) {
+		snprintf(pointer, sizeof pointer, "%s", ja ? "second" : "first");
+		d = -1;
+	} else {
+		d = value_difference(ja, jb, "", pointer);
+		if (d < 0) {
+			snprintf(pointer, sizeof pointer, "out of memory");
+			d = 1;
+		}
+	}
+	json_decref(ja);
+	json_decref(jb);
+	if (where && size)
+		snprintf(where, size, "%s", pointer);
+	return d;
 }

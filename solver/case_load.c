@@ -70,7 +70,7 @@ static const char *const component_names[] = { "x", "y", NULL };
 /* Keys allowed in each object. */
 static const char *const top_keys[] = { "schema", "title", "formulation", "grid", "materials", "bodies",
 					"fluid", "gravity", "boundaries", "loads", "time", "output",
-					"probes", NULL };
+					"probes", "checkpoint", NULL };
 static const char *const formulation_keys[] = { "scheme", "phases", "shape", "pore_pressure_smoothing",
 						"flip_fraction", "pressure_projection", "soil_stabilisation",
 						"drag_in_correction", NULL };
@@ -86,6 +86,7 @@ static const char *const face_boundary_keys[] = { "soil", "water", "drainage", N
 static const char *const load_keys[] = { "body", "face", "from", "to", "traction", "time_function", NULL };
 static const char *const time_keys[] = { "dt", "end", NULL };
 static const char *const output_keys[] = { "frame_interval", "progress_interval", NULL };
+static const char *const checkpoint_keys[] = { "interval", NULL };
 /* Keys of a time function and of a probe depend on its kind; the last entry is the union, used
  * when the kind itself is missing or wrong. */
 static const char *const *const time_function_keys[] = {
@@ -588,6 +589,16 @@ static void read_output(struct case_reader *r, const json_t *root, struct case_s
 			 &c->output.progress_interval);
 }
 
+/* {"interval": s of simulated time}: absent means no checkpoints (interval 0). */
+static void read_checkpoint(struct case_reader *r, const json_t *root, struct case_spec *c)
+{
+	const json_t *o = case_read_object(r, root, "", "checkpoint", CASE_OPTIONAL);
+	if (!o)
+		return;
+	case_check_keys(r, o, "/checkpoint", checkpoint_keys);
+	case_read_number(r, o, "/checkpoint", "interval", CASE_REQUIRED, &POSITIVE, &c->checkpoint.interval);
+}
+
 static void read_probe(struct case_reader *r, const json_t *o, const char *p, const struct case_spec *c,
 		       int grid_ok, struct case_probe *probe)
 {
@@ -669,6 +680,7 @@ static void read_case(struct case_reader *r, const json_t *root, struct case_spe
 	read_time(r, root, c);
 	read_output(r, root, c);
 	read_probes(r, root, c, grid_ok);
+	read_checkpoint(r, root, c);
 }
 
 enum poro_status case_load_string(const char *json, struct case_spec **out, struct poro_error *err)

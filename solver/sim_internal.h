@@ -57,6 +57,8 @@ struct sim {
 	double water_outflow_mass;    /* kg/m of water points that left through drained faces */
 	double phase_seconds[PHASE_COUNT]; /* wall time per phase, accumulated over steps */
 	int *probe_point;             /* [probe_count] tracked point of point probes, -1 otherwise */
+	int resumed;                  /* 1: the state was loaded from a checkpoint (checkpoint.c) */
+	double checkpoint_wall;       /* s of wall time between checkpoints in sim_run; 0 = none */
 	struct poro_error err;
 };
 
