@@ -14,11 +14,26 @@ packages=(
   python3               # test harness helpers
 )
 
+# The OpenAPI linter of make test (tools/openapi-lint, pinned in its package-lock.json) runs on
+# Node.js >= 20.19; Debian's nodejs package is installed only where no node is present at all.
+command -v node >/dev/null 2>&1 || packages+=(nodejs npm)
+
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
 done
-[ ${#missing[@]} -eq 0 ] && exit 0
+
+lint_dir="$(cd "$(dirname "$0")/.." && pwd)/tools/openapi-lint"
+install_linter() {
+  [ -x "$lint_dir/node_modules/.bin/redocly" ] && return 0
+  echo "deps: installing the OpenAPI linter (npm ci in tools/openapi-lint)"
+  (cd "$lint_dir" && npm ci --no-audit --no-fund --loglevel=error)
+}
+
+if [ ${#missing[@]} -eq 0 ]; then
+  install_linter
+  exit 0
+fi
 
 SUDO=""
 [ "$(id -u)" -eq 0 ] || SUDO="sudo"
@@ -26,3 +41,4 @@ echo "deps: installing ${missing[*]}"
 export DEBIAN_FRONTEND=noninteractive
 $SUDO apt-get update -qq
 $SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}"
+install_linter
