@@ -1,9 +1,16 @@
 /*
  * poro_solve.c - the poro-solve command: the solver library behind a command line.
  *
- *   poro-solve run CASE.json --out DIR   run a case, write DIR/result.h5 and DIR/result.xdmf
+ *   poro-solve run CASE.json --out DIR [--resume CHECKPOINT] [--checkpoint-wall SECONDS]
+ *                                        run a case, write DIR/result.h5 and DIR/result.xdmf
  *   poro-solve validate CASE.json        check a case; every problem as "JSON-pointer: message"
  *   poro-solve version
+ *
+ * run writes DIR/checkpoint.h5 every checkpoint.interval of simulated time (case key) and every
+ * --checkpoint-wall seconds of wall time, whichever comes first, and prints
+ * "checkpoint step=N time=T" after each; --resume continues from such a checkpoint, keeping the
+ * frames of DIR/result.h5 up to it (checkpoint.h, docs/service.md §2). A checkpoint of another
+ * case is refused with exit 2, naming the first difference.
  *
  * Exit codes come from the status table in error.h: 0 success, 2 invalid input, 3 solver failure
  * (NaN, a point leaving the grid, a failed factorisation), 4 I/O, 5 out of memory, 6 interrupted.
@@ -11,9 +18,11 @@
  */
 #include <signal.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include "case.h"
+#include "checkpoint.h"
 #include "poro.h"
 
 #ifndef PORO_VERSION
@@ -30,7 +39,7 @@ static void on_signal(int sig)
 
 static int usage(void)
 {
-	fprintf(stderr, "usage: poro-solve run CASE.json --out DIR\n"
+	fprintf(stderr, "usage: poro-solve run CASE.json --out DIR [--resume CHECKPOINT] [--checkpoint-wall SECONDS]\n"
 			"       poro-solve validate CASE.json\n"
 			"       poro-solve version\n");
 	return 2;
@@ -45,6 +54,11 @@ static int fail(enum poro_status st, const struct poro_error *err, const char *w
 static void print_progress(const struct sim_progress *p, void *user)
 {
 	(void)user;
+	if (p->checkpoint) {   /* the worker uploads checkpoint.h5 and result.h5 on this line */
+		printf("checkpoint step=%ld time=%.9g\n", p->step, p->time);
+		fflush(stdout);
+		return;
+	}
 	printf("step %ld/%ld  t = %.6g s  wall = %.2f s  %.3f us per material-point step\n", p->step,
 	       p->steps_total, p->time, p->wall_seconds, p->us_per_point_step);
 	fflush(stdout);
@@ -62,8 +76,16 @@ static int cmd_validate(const char *path)
 	return 0;
 }
 
-static int cmd_run(const char *path, const char *out_dir)
+/* What `run` was asked for besides the case. */
+struct run_options {
+	const char *out_dir;
+	const char *resume;         /* checkpoint to continue from, or NULL */
+	double checkpoint_wall;     /* s of wall time between checkpoints, 0 = none */
+};
+
+static int cmd_run(const char *path, const struct run_options *opt)
 {
+	const char *out_dir = opt->out_dir;
 	struct case_spec *c = NULL;
 	struct sim *s = NULL;
 	struct poro_error err = {0};
@@ -75,8 +97,17 @@ static int cmd_run(const char *path, const char *out_dir)
 		case_destroy(&c);
 		return fail(st, &err, path);
 	}
+	if (opt->resume && (st = checkpoint_load(s, opt->resume))) {
+		int code = fail(st, sim_error(s), opt->resume);
+		sim_destroy(&s);
+		case_destroy(&c);
+		return code;
+	}
+	sim_set_checkpoint_wall(s, opt->checkpoint_wall);
 	printf("case '%s': %ld soil points, %ld water points, %ld steps\n", c->title,
 	       (long)sim_soil(s)->n, sim_is_double_point(s) ? (long)sim_water(s)->n : 0L, sim_steps_total(s));
+	if (opt->resume)
+		printf("resumed from '%s' at step %ld, t = %.6g s\n", opt->resume, sim_steps_taken(s), sim_time(s));
 	signal(SIGTERM, on_signal);
 	signal(SIGINT, on_signal);
 	st = sim_run(s, out_dir, PORO_VERSION, print_progress, NULL, &stop_requested);
@@ -90,6 +121,32 @@ static int cmd_run(const char *path, const char *out_dir)
 	return code;
 }
 
+/* run CASE.json --out DIR [--resume CHECKPOINT] [--checkpoint-wall SECONDS], options in any order. */
+static int parse_run(int argc, char **argv)
+{
+	struct run_options opt = {0};
+	for (int i = 3; i < argc; i += 2) {
+		if (i + 1 >= argc)
+			return usage();
+		if (!strcmp(argv[i], "--out")) {
+			opt.out_dir = argv[i + 1];
+		} else if (!strcmp(argv[i], "--resume")) {
+			opt.resume = argv[i + 1];
+		} else if (!strcmp(argv[i], "--checkpoint-wall")) {
+			char *end;
+			opt.checkpoint_wall = strtod(argv[i + 1], &end);
+			if (end == argv[i + 1] || *end || !(opt.checkpoint_wall > 0) || opt.checkpoint_wall > 1e9) {
+				fprintf(stderr, "poro-solve: --checkpoint-wall: '%s' is not a number of seconds > 0\n",
+					argv[i + 1]);
+				return 2;
+			}
+		} else {
+			return usage();
+		}
+	}
+	return opt.out_dir ? cmd_run(argv[2], &opt) : usage();
+}
+
 int main(int argc, char **argv)
 {
 	if (argc >= 2 && !strcmp(argv[1], "version")) {
@@ -98,7 +155,7 @@ int main(int argc, char **argv)
 	}
 	if (argc == 3 && !strcmp(argv[1], "validate"))
 		return cmd_validate(argv[2]);
-	if (argc == 5 && !strcmp(argv[1], "run") && !strcmp(argv[3], "--out"))
-		return cmd_run(argv[2], argv[4]);
+	if (argc >= 3 && !strcmp(argv[1], "run"))
+		return parse_run(argc, argv);
 	return usage();
 }

@@ -1,6 +1,6 @@
 /*
  * hdf5_reason.h - HDF5's reason for a failure, for error messages (private to the HDF5 files:
- * output.c and results_read.c, the only ones that include hdf5.h).
+ * output.c, checkpoint.c and results_read.c, the only ones that include hdf5.h).
  *
  * HDF5 prints its error stack by default and clears it in the cleanup calls that follow a failure,
  * before the failure can be reported. hdf5_record_reason is installed with H5Eset_auto2 in place

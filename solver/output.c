@@ -36,6 +36,7 @@
 #include <time.h>
 #include <unistd.h>
 
+#include "case.h"
 #include "hdf5_reason.h"
 
 #include "output_xdmf.h"
@@ -533,9 +534,10 @@ static enum poro_status probes_init(struct output *o, int count, const char *con
 	return PORO_OK;
 }
 
-enum poro_status output_create(struct output **out, const char *dir, const char *case_json,
-			       const char *solver_version, int probe_count, const char *const *probe_names,
-			       const char *const *probe_units, struct poro_error *err)
+/* The writer without its file: arguments checked, probe list copied, paths made. */
+static enum poro_status writer_new(struct output **out, const char *dir, const char *case_json,
+				   const char *solver_version, int probe_count, const char *const *probe_names,
+				   const char *const *probe_units, struct poro_error *err)
 {
 	*out = NULL;
 	if (!dir || !case_json || !solver_version)
@@ -565,14 +567,23 @@ enum poro_status output_create(struct output **out, const char *dir, const char 
 	}
 	snprintf(o->path, len, "%s/%s", dir, OUTPUT_H5_NAME);
 	st = probes_init(o, probe_count, probe_names, probe_units, err);
-	if (!st)
-		st = file_create(o, case_json, solver_version, err);
 	if (st) {
 		output_destroy(&o);
 		return st;
 	}
 	*out = o;
 	return PORO_OK;
+}
+
+enum poro_status output_create(struct output **out, const char *dir, const char *case_json,
+			       const char *solver_version, int probe_count, const char *const *probe_names,
+			       const char *const *probe_units, struct poro_error *err)
+{
+	enum poro_status st = writer_new(out, dir, case_json, solver_version, probe_count, probe_names,
+					 probe_units, err);
+	if (!st && (st = file_create(*out, case_json, solver_version, err)))
+		output_destroy(out);
+	return st;
 }
 
 /* ---- frames ------------------------------------------------------------------------------------ */
@@ -617,6 +628,171 @@ enum poro_status output_frame_write(struct output *o, const struct output_frame 
 	struct xdmf_frame listed = {o->frame_next++, f->time, f->soil->n, f->water ? f->water->n : -1};
 	st = xdmf_index_add(&o->xdmf, &listed, err);
 	return st ? st : xdmf_index_write(&o->xdmf, o->dir, err);
+}
+
+/* ---- continuing a file (a resumed run) ------------------------------------------------------- */
+
+/* Cuts every probe series back to its samples at times <= keep_until; all must keep as many. */
+static enum poro_status probes_cut(struct output *o, double keep_until, struct poro_error *err)
+{
+	char path[OUTPUT_PATH_MAX];
+	for (int j = 0; j < o->probe_count; j++) {
+		struct output_probe *pr = &o->probes[j];
+		snprintf(path, sizeof path, "/probes/%s/time", pr->name);
+		pr->time = H5Dopen2(o->file, path, H5P_DEFAULT);
+		snprintf(path, sizeof path, "/probes/%s/value", pr->name);
+		pr->value = pr->time < 0 ? -1 : H5Dopen2(o->file, path, H5P_DEFAULT);
+		if (pr->value < 0)
+			return h5_fail(o, err, "open", path);
+		hid_t space = H5Dget_space(pr->time), vspace = H5Dget_space(pr->value);
+		hssize_t n = space < 0 ? -1 : H5Sget_simple_extent_npoints(space);
+		hssize_t nv = vspace < 0 ? -1 : H5Sget_simple_extent_npoints(vspace);
+		if (space >= 0)
+			H5Sclose(space);
+		if (vspace >= 0)
+			H5Sclose(vspace);
+		double *t = n >= 0 ? malloc(((size_t)n + 1) * sizeof *t) : NULL;
+		if (!t || (n > 0 && H5Dread(pr->time, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, t) < 0)) {
+			free(t);
+			snprintf(path, sizeof path, "/probes/%s/time", pr->name);
+			return n < 0 ? h5_fail(o, err, "read", path) : no_memory(err, "a probe series");
+		}
+		hsize_t keep = 0;   /* samples are in time order: keep the leading ones */
+		while ((hssize_t)keep < n && t[keep] <= keep_until)
+			keep++;
+		free(t);
+		if (nv < (hssize_t)keep || (j > 0 && keep != o->samples_written))
+			return poro_error_set(err, PORO_EINVAL, "cannot continue '%s': probe '%s' has %lld samples "
+					      "up to the checkpoint, %lld values, other probes %llu", o->path, pr->name,
+					      (long long)keep, (long long)nv, (unsigned long long)o->samples_written);
+		if (H5Dset_extent(pr->time, &keep) < 0 || H5Dset_extent(pr->value, &keep) < 0)
+			return h5_fail(o, err, "cut", path);
+		o->samples_written = keep;
+	}
+	return PORO_OK;
+}
+
+/* Points in <frame>/<set>/x, -1 when the set is absent or unreadable. */
+static long set_points(const struct output *o, const char *frame, const char *set)
+{
+	char path[OUTPUT_PATH_MAX];
+	snprintf(path, sizeof path, "%s/%s/x", frame, set);
+	if (H5Lexists(o->file, frame, H5P_DEFAULT) <= 0 || H5Lexists(o->file, path, H5P_DEFAULT) <= 0)
+		return -1;
+	hid_t ds = H5Dopen2(o->file, path, H5P_DEFAULT);
+	hid_t space = ds < 0 ? -1 : H5Dget_space(ds);
+	hsize_t dims[2] = {0, 0};
+	int rank = space < 0 ? -1 : H5Sget_simple_extent_dims(space, dims, NULL);
+	if (space >= 0)
+		H5Sclose(space);
+	if (ds >= 0)
+		H5Dclose(ds);
+	return rank == 2 ? (long)dims[0] : -1;
+}
+
+/* Keeps the frames at times <= keep_until, in sequence order, and lists them in the xdmf index;
+ * deletes the rest (later frames, and one a killed run left half written). */
+static enum poro_status frames_cut(struct output *o, double keep_until, struct poro_error *err)
+{
+	H5G_info_t info;
+	if (H5Gget_info_by_name(o->file, "/frames", &info, H5P_DEFAULT) < 0)
+		return h5_fail(o, err, "open", "/frames");
+	/* the names first: deleting links while walking them by index would skip some */
+	char (*names)[16] = calloc(info.nlinks + 1, sizeof *names);
+	if (!names)
+		return no_memory(err, "the frame list");
+	enum poro_status st = PORO_OK;
+	for (hsize_t i = 0; i < info.nlinks && !st; i++)
+		if (H5Lget_name_by_idx(o->file, "/frames", H5_INDEX_NAME, H5_ITER_INC, i, names[i], sizeof names[i],
+				       H5P_DEFAULT) < 0)
+			st = h5_fail(o, err, "list", "/frames");
+	int keeping = 1;
+	for (hsize_t i = 0; i < info.nlinks && !st; i++) {
+		char path[OUTPUT_PATH_MAX];
+		snprintf(path, sizeof path, "/frames/%s", names[i]);
+		double time = 0.0;
+		long soil_n = set_points(o, path, "soil");
+		long index = strtol(names[i], NULL, 10);
+		hid_t a = H5Aopen_by_name(o->file, path, "time", H5P_DEFAULT, H5P_DEFAULT);
+		int ok = a >= 0 && H5Aread(a, H5T_NATIVE_DOUBLE, &time) >= 0;
+		if (a >= 0)
+			H5Aclose(a);
+		reason_clear();   /* a frame that cannot be read is dropped, not an error */
+		keeping = keeping && ok && soil_n >= 0 && time <= keep_until;
+		if (!keeping) {
+			if (H5Ldelete(o->file, path, H5P_DEFAULT) < 0)
+				st = h5_fail(o, err, "delete", path);
+			continue;
+		}
+		long water_n = set_points(o, path, "water");   /* -1: single point */
+		reason_clear();
+		struct xdmf_frame listed = {index, time, soil_n, water_n};
+		st = xdmf_index_add(&o->xdmf, &listed, err);
+		o->frame_next = index + 1;
+	}
+	free(names);
+	return st;
+}
+
+static enum poro_status file_reopen(struct output *o, const char *case_json, const char *solver_version,
+				    double keep_until, struct poro_error *err)
+{
+	hid_t fapl = H5Pcreate(H5P_FILE_ACCESS);
+	if (fapl >= 0 && H5Pset_fclose_degree(fapl, H5F_CLOSE_STRONG) >= 0 && H5Pset_file_locking(fapl, 0, 1) >= 0)
+		o->file = H5Fopen(o->path, H5F_ACC_RDWR, fapl);
+	if (fapl >= 0)
+		H5Pclose(fapl);
+	if (o->file < 0)
+		return h5_fail(o, err, "open", NULL);
+	o->string = H5Tcopy(H5T_C_S1);
+	if (o->string < 0 || H5Tset_size(o->string, H5T_VARIABLE) < 0 || H5Tset_cset(o->string, H5T_CSET_UTF8) < 0)
+		return h5_fail(o, err, "create", "string type");
+	char *stored = NULL, where[OUTPUT_PATH_MAX];
+	hid_t a = H5Aopen_by_name(o->file, "/case", "json", H5P_DEFAULT, H5P_DEFAULT);
+	int rc = a < 0 || H5Aread(a, o->string, &stored) < 0 || !stored ? -1 : 0;
+	if (a >= 0)
+		H5Aclose(a);
+	if (rc < 0)
+		return h5_fail(o, err, "read", "/case");
+	int d = case_json_difference(stored, case_json, where, sizeof where);
+	H5free_memory(stored);
+	if (d)
+		return poro_error_set(err, PORO_EINVAL, "cannot continue '%s': it holds the results of a different "
+				      "case ('%s' differs)", o->path, d > 0 ? where : "/case");
+	hid_t run = H5Gopen2(o->file, "/run", H5P_DEFAULT);
+	rc = run < 0 || attr_string(o, run, "status", "running") < 0 ||
+	     attr_string(o, run, "solver_version", solver_version) < 0 ||
+	     attr_double(run, "resumed_from_time", keep_until) < 0 ? -1 : 0;
+	if (run >= 0 && H5Gclose(run) < 0)
+		rc = -1;
+	if (rc < 0)
+		return h5_fail(o, err, "write", "/run");
+	enum poro_status st = probes_cut(o, keep_until, err);
+	if (!st)
+		st = frames_cut(o, keep_until, err);
+	if (!st)
+		st = file_sync(o, err);
+	return st ? st : xdmf_index_write(&o->xdmf, o->dir, err);
+}
+
+enum poro_status output_reopen(struct output **out, const char *dir, const char *case_json,
+			       const char *solver_version, int probe_count, const char *const *probe_names,
+			       const char *const *probe_units, double keep_until, struct poro_error *err)
+{
+	enum poro_status st = writer_new(out, dir, case_json, solver_version, probe_count, probe_names,
+					 probe_units, err);
+	if (!st && (st = file_reopen(*out, case_json, solver_version, keep_until, err)))
+		output_destroy(out);
+	return st;
+}
+
+enum poro_status output_flush(struct output *o, struct poro_error *err)
+{
+	if (!o || o->finished)
+		return poro_error_set(err, PORO_EINVAL, "cannot flush the output: it is closed");
+	reason_clear();
+	enum poro_status st = probes_write(o, err);
+	return st ? st : file_sync(o, err);
 }
 
 /* ---- end of the run ------------------------------------------------------------------------------ */

@@ -15,7 +15,7 @@
  * atomically (write to a temporary name, rename), so a run killed at any moment leaves every
  * completed frame readable. Probes are buffered in memory and written at each frame and at close.
  *
- * HDF5 enters only through output*.c and results_read.c (STYLE rule 5).
+ * HDF5 enters only through output*.c, checkpoint.c and results_read.c (STYLE rule 5).
  */
 #ifndef PORO_OUTPUT_H
 #define PORO_OUTPUT_H
@@ -39,6 +39,20 @@ struct output_frame {
 enum poro_status output_create(struct output **out, const char *dir, const char *case_json,
 			       const char *solver_version, int probe_count, const char *const *probe_names,
 			       const char *const *probe_units, struct poro_error *err);
+
+/* Continues an existing DIR/result.h5 for a run resumed at a checkpoint: keeps the frames and
+ * probe samples at times <= keep_until, deletes later ones (and a frame a killed run left half
+ * written), sets /run status back to "running" with attribute resumed_from_time, rewrites
+ * result.xdmf to list the kept frames; new frames and samples are then appended after them.
+ * PORO_EINVAL when the file holds another case (case_json_difference) or inconsistent probe
+ * series; PORO_EIO when it cannot be opened or changed. */
+enum poro_status output_reopen(struct output **out, const char *dir, const char *case_json,
+			       const char *solver_version, int probe_count, const char *const *probe_names,
+			       const char *const *probe_units, double keep_until, struct poro_error *err);
+
+/* Writes the buffered probe samples and makes the file durable (flush and fsync), so a copy taken
+ * now holds every frame and sample so far: done before each checkpoint. */
+enum poro_status output_flush(struct output *o, struct poro_error *err);
 
 /* Appends one sample to each probe (values[probe_count]). Buffered; no I/O. */
 enum poro_status output_probe_sample(struct output *o, double time, const double *values, struct poro_error *err);

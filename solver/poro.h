@@ -73,14 +73,23 @@ double sim_probe_value(const struct sim *s, int i);
 struct sim_progress {
 	long step, steps_total;
 	double time, end_time, wall_seconds;
-	double us_per_point_step;        /* wall microseconds per material-point step so far */
+	double us_per_point_step;        /* wall microseconds per material-point step of this run so far */
+	int checkpoint;                  /* 1: not a progress report but the announcement that
+					    DIR/checkpoint.h5 now holds this step (checkpoint.h) */
 };
 typedef void (*sim_progress_fn)(const struct sim_progress *p, void *user);
 
 /* Runs to the end time writing out_dir/result.h5 and result.xdmf (frames at the case's
  * frame_interval, probes every step); calls progress every progress_interval of wall time and
- * at the end. stop (may be NULL) is polled each step: non-zero interrupts with PORO_EINTERRUPTED. */
+ * at the end. stop (may be NULL) is polled each step: non-zero interrupts with PORO_EINTERRUPTED.
+ * Writes out_dir/checkpoint.h5 every checkpoint.interval of simulated time (case) or every
+ * sim_set_checkpoint_wall() seconds of wall time, whichever comes first, and calls progress with
+ * checkpoint = 1 after each. A sim loaded from a checkpoint (checkpoint_load) continues from its
+ * step and continues out_dir/result.h5 when it exists (run.c says how). */
 enum poro_status sim_run(struct sim *s, const char *out_dir, const char *solver_version,
 			 sim_progress_fn progress, void *user, volatile int *stop);
+
+/* Wall-clock interval between checkpoints in sim_run, s; 0 (the default) = by simulated time only. */
+void sim_set_checkpoint_wall(struct sim *s, double seconds);
 
 #endif

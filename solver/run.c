@@ -4,14 +4,28 @@
  * Frames are written at t = 0, whenever the time passes a multiple of frame_interval, and at the
  * end (also at a failure, so the state that failed can be inspected). Probes are sampled every
  * step, thinned to at most about PROBE_SAMPLES_TARGET samples per run.
+ *
+ * Checkpoints (checkpoint.h) are written after the frame of a step, whenever the time passes a
+ * multiple of the case's checkpoint.interval or checkpoint_wall seconds of wall time have gone by
+ * since the last one, whichever comes first (never at the end: the run is then complete).
+ * result.h5 is flushed first, so a copy of it taken after the checkpoint holds every frame and
+ * probe sample up to the checkpoint time.
+ *
+ * A run resumed from a checkpoint keeps the same schedules: frames, probe samples (the thinning
+ * depends on the step number only) and checkpoints fall on the same steps as in an uninterrupted
+ * run. If DIR/result.h5 exists, its frames and samples up to the checkpoint time are kept and the
+ * run appends to it; otherwise a new result.h5 begins with a frame and a probe sample at the
+ * checkpoint time.
  */
 #include <errno.h>
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
 #include <time.h>
 
+#include "checkpoint.h"
 #include "output.h"
 #include "sim_internal.h"
 
@@ -40,21 +54,27 @@ static enum poro_status sample_probes(struct sim *s, struct output *o, double *v
 	return output_probe_sample(o, s->time, values, &s->err);
 }
 
-static void report(struct sim *s, sim_progress_fn progress, void *user, double t0)
+/* step0: the step the run started from (non-zero after a resume), so the speed counts only the
+ * steps this process took. */
+static void report(struct sim *s, sim_progress_fn progress, void *user, double t0, long step0, int checkpoint)
 {
 	if (!progress)
 		return;
 	double wall = wall_now() - t0;
 	long points = (long)s->soil.n + (s->double_point ? (long)s->water.n : 0);
+	long steps = s->step - step0;
 	struct sim_progress pr = {
 		.step = s->step, .steps_total = s->steps_total, .time = s->time,
 		.end_time = s->spec->time.end, .wall_seconds = wall,
-		.us_per_point_step = s->step > 0 ? 1e6 * wall / ((double)s->step * points) : 0.0,
+		.us_per_point_step = steps > 0 ? 1e6 * wall / ((double)steps * points) : 0.0,
+		.checkpoint = checkpoint,
 	};
 	progress(&pr, user);
 }
 
-static enum poro_status open_output(struct sim *s, const char *dir, const char *version, struct output **o)
+/* Creates DIR/result.h5, or after a resume continues it when it exists (*appended = 1). */
+static enum poro_status open_output(struct sim *s, const char *dir, const char *version, struct output **o,
+				    int *appended)
 {
 	if (mkdir(dir, 0777) && errno != EEXIST)
 		return poro_error_set(&s->err, PORO_EIO, "cannot create output directory '%s': %s", dir, strerror(errno));
@@ -72,9 +92,37 @@ static enum poro_status open_output(struct sim *s, const char *dir, const char *
 			 (p->kind == PROBE_AVERAGE && p->field != FIELD_DISPLACEMENT_X && p->field != FIELD_DISPLACEMENT_Y);
 		units[i] = pa ? "Pa" : "m";
 	}
-	enum poro_status st = output_create(o, dir, s->spec->json, version, n, names, units, &s->err);
+	char path[1024];
+	struct stat sb;
+	snprintf(path, sizeof path, "%s/result.h5", dir);
+	*appended = s->resumed && stat(path, &sb) == 0;
+	/* every frame or sample of a later step is at least dt later than the checkpoint */
+	enum poro_status st = *appended ?
+		output_reopen(o, dir, s->spec->json, version, n, names, units, s->time + 0.5 * s->dt, &s->err) :
+		output_create(o, dir, s->spec->json, version, n, names, units, &s->err);
 	free(names);
 	free(units);
+	return st;
+}
+
+void sim_set_checkpoint_wall(struct sim *s, double seconds) { s->checkpoint_wall = seconds > 0 ? seconds : 0; }
+
+/* Number of the first multiple of interval after time (1 at t = 0), with the same tolerance the
+ * due tests use, so a resumed run schedules what the uninterrupted run would. */
+static long next_multiple(double time, double interval)
+{
+	return interval > 0 ? (long)floor(time / interval * (1 + 1e-9)) + 1 : 1;
+}
+
+/* Flushes result.h5, writes the checkpoint and announces it. */
+static enum poro_status checkpoint(struct sim *s, struct output *o, const char *dir, sim_progress_fn progress,
+				   void *user, double t0, long step0)
+{
+	enum poro_status st = output_flush(o, &s->err);
+	if (!st)
+		st = checkpoint_write(s, dir);
+	if (!st)
+		report(s, progress, user, t0, step0, 1);
 	return st;
 }
 
@@ -83,17 +131,21 @@ enum poro_status sim_run(struct sim *s, const char *out_dir, const char *solver_
 {
 	struct output *o = NULL;
 	const double t0 = wall_now();
+	const long step0 = s->step;
+	int appended = 0;
 	double *values = calloc((size_t)s->spec->probe_count + 1, sizeof(double));
 	if (!values)
 		return poro_error_set(&s->err, PORO_ENOMEM, "cannot allocate probe values");
-	enum poro_status st = open_output(s, out_dir, solver_version, &o);
+	enum poro_status st = open_output(s, out_dir, solver_version, &o, &appended);
 	const double interval = s->spec->output.frame_interval;
+	const double checkpoint_interval = s->spec->checkpoint.interval;
 	const long thin = s->steps_total / PROBE_SAMPLES_TARGET + 1;
-	double last_report = t0;
-	long next_frame = 1;
-	if (!st)
+	double last_report = t0, last_checkpoint = t0;
+	long next_frame = next_multiple(s->time, interval);
+	long next_checkpoint = next_multiple(s->time, checkpoint_interval);
+	if (!st && !appended)
 		st = write_frame(s, o);
-	if (!st)
+	if (!st && !appended)
 		st = sample_probes(s, o, values);
 	while (!st && !sim_done(s)) {
 		if (stop && *stop) {
@@ -108,10 +160,17 @@ enum poro_status sim_run(struct sim *s, const char *out_dir, const char *solver_
 			st = sample_probes(s, o, values);
 		if (!st && interval > 0 && s->time >= next_frame * interval * (1 - 1e-9) && !sim_done(s)) {
 			st = write_frame(s, o);
-			next_frame = (long)floor(s->time / interval * (1 + 1e-9)) + 1;
+			next_frame = next_multiple(s->time, interval);
+		}
+		int due = (checkpoint_interval > 0 && s->time >= next_checkpoint * checkpoint_interval * (1 - 1e-9)) ||
+			  (s->checkpoint_wall > 0 && wall_now() - last_checkpoint >= s->checkpoint_wall);
+		if (!st && due && !sim_done(s)) {
+			st = checkpoint(s, o, out_dir, progress, user, t0, step0);
+			next_checkpoint = next_multiple(s->time, checkpoint_interval);
+			last_checkpoint = wall_now();
 		}
 		if (wall_now() - last_report >= s->spec->output.progress_interval) {
-			report(s, progress, user, t0);
+			report(s, progress, user, t0, step0, 0);
 			last_report = wall_now();
 		}
 	}
@@ -127,7 +186,7 @@ enum poro_status sim_run(struct sim *s, const char *out_dir, const char *solver_
 			final = fin;
 		output_destroy(&o);
 	}
-	report(s, progress, user, t0);
+	report(s, progress, user, t0, step0, 0);
 	free(values);
 	return final;
 }
