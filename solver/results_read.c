@@ -344,3 +344,37 @@ enum poro_status results_frame_read(struct results *r, long frame, const char *s
 	st = read_dataset(r, path, values, rows, width, err);
 	return quiet_end(h, st);
 }
+
+enum poro_status results_probe_read(struct results *r, const char *name, double **time, double **value,
+				    long *count, char **units, struct poro_error *err)
+{
+	*time = *value = NULL;
+	*units = NULL;
+	*count = 0;
+	char group[RESULTS_PATH_MAX / 2], path[RESULTS_PATH_MAX];
+	if (!name || !*name || strchr(name, '/') || strlen(name) >= sizeof group - 16)
+		return poro_error_set(err, PORO_EINVAL, "invalid probe name '%s'", name ? name : "(null)");
+	snprintf(group, sizeof group, "/probes/%s", name);
+	struct handler h = quiet_begin();
+	if (H5Lexists(r->file, "/probes", H5P_DEFAULT) <= 0 || H5Lexists(r->file, group, H5P_DEFAULT) <= 0)
+		return quiet_end(h, poro_error_set(err, PORO_EINVAL, "no probe '%s' in '%s'", name, r->path));
+	long n_time = 0, n_value = 0;
+	snprintf(path, sizeof path, "%s/time", group);
+	enum poro_status st = read_dataset(r, path, time, &n_time, NULL, err);
+	snprintf(path, sizeof path, "%s/value", group);
+	if (!st)
+		st = read_dataset(r, path, value, &n_value, NULL, err);
+	if (!st && read_string_attr(r->file, path, "units", units) < 0)
+		st = h5_fail(r->path, err, "read units of", path);
+	if (!st && n_time != n_value)
+		st = poro_error_set(err, PORO_EIO, "probe '%s' in '%s' has %ld times but %ld values", name, r->path,
+				    n_time, n_value);
+	if (st) {
+		free(*time), free(*value), free(*units);
+		*time = *value = NULL;
+		*units = NULL;
+		return quiet_end(h, st);
+	}
+	*count = n_time;
+	return quiet_end(h, PORO_OK);
+}

@@ -58,6 +58,12 @@ int results_frame_has_set(struct results *r, long frame, const char *set, struct
 enum poro_status results_frame_read(struct results *r, long frame, const char *set, const char *name,
 				    double **values, long *rows, int *width, struct poro_error *err);
 
+/* Reads probe `name` (a name from the case's "probes"): its sample times (s) and values, each
+ * [*count], malloc'd and owned by the caller, and its "units" attribute (the caller frees *units).
+ * A probe the file does not hold is PORO_EINVAL naming it. */
+enum poro_status results_probe_read(struct results *r, const char *name, double **time, double **value,
+				    long *count, char **units, struct poro_error *err);
+
 /* The case the run was given (/case attribute "json"), exactly as given; owned by r, valid until
  * results_close(). */
 const char *results_case_json(const struct results *r);

@@ -39,7 +39,8 @@ static const char case_format[] =
 	" \"boundaries\": {\"left\": {\"soil\": \"slip\", \"water\": \"slip\"},"
 	"   \"right\": {\"soil\": \"slip\", \"water\": \"slip\"}, \"bottom\": {\"soil\": \"slip\", \"water\": \"slip\"}},"
 	" \"loads\": [{\"body\": \"column\", \"face\": \"top\", \"traction\": [0.0, -1.2345e4]}],"
-	" \"time\": {\"dt\": %g, \"end\": %g}, \"output\": {\"frame_interval\": %g}}";
+	" \"time\": {\"dt\": %g, \"end\": %g}, \"output\": {\"frame_interval\": %g},"
+	" \"probes\": [{\"name\": \"p_base\", \"kind\": \"pore_pressure\", \"point\": [0.05, 0.0]}]}";
 
 /* ---- fixtures ---------------------------------------------------------------------------------- */
 
@@ -182,6 +183,34 @@ static void check_last_frame(struct results *r, const struct sim *s, const char 
 	      set_rows(r, last, "water"), nw);
 }
 
+/* The probe series: one sample per step from t = 0 (sim_run samples every step), strictly
+ * increasing times ending at the run's end, the last value the simulation's, units "Pa"; a probe
+ * the case does not have is refused by name. */
+static void check_probe(struct results *r, const struct sim *s, const char *phases)
+{
+	char name[128];
+	double *t = NULL, *v = NULL;
+	char *units = NULL;
+	long n = 0;
+	struct poro_error err = {0};
+	enum poro_status st = results_probe_read(r, "p_base", &t, &v, &n, &units, &err);
+	snprintf(name, sizeof name, "%s_probe_read", phases);
+	CHECK(!st && n > 1, name, "%ld samples: %s", n, err.message);
+	int increasing = 1;
+	for (long k = 1; k < n; k++)
+		increasing &= t[k] > t[k - 1];
+	snprintf(name, sizeof name, "%s_probe_times_increase_to_end", phases);
+	CHECK(!st && increasing && fabs(t[n - 1] - sim_time(s)) <= TIME_TOL, name, "last time %.17g, sim at %.17g",
+	      n ? t[n - 1] : -1.0, sim_time(s));
+	snprintf(name, sizeof name, "%s_probe_last_value_and_units", phases);
+	CHECK(!st && v[n - 1] == sim_probe_value(s, 0) && units && !strcmp(units, "Pa"), name,
+	      "last %.17g, sim %.17g, units '%s'", n ? v[n - 1] : 0.0, sim_probe_value(s, 0), units ? units : "");
+	free(t), free(v), free(units);
+	st = results_probe_read(r, "p_top", &t, &v, &n, &units, &err);
+	snprintf(name, sizeof name, "%s_unknown_probe_refused", phases);
+	CHECK(st == PORO_EINVAL && !t && !v && strstr(err.message, "p_top"), name, "status %d: %s", st, err.message);
+}
+
 /* Runs the column with the given phases into dir and checks what the reader gives back. */
 static void check_run(const char *phases, const char *dir)
 {
@@ -207,6 +236,7 @@ static void check_run(const char *phases, const char *dir)
 		CHECK(!strcmp(results_case_json(r), json), name, "got %.80s...", results_case_json(r));
 		check_frames(r, s, phases);
 		check_last_frame(r, s, phases);
+		check_probe(r, s, phases);
 	}
 	results_close(&r);
 	snprintf(name, sizeof name, "%s_close_clears_pointer", phases);

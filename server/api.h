@@ -1,0 +1,55 @@
+/*
+ * api.h - the route handlers (docs/service.md §3), grouped by caller: jobs_api.c (users),
+ * worker_api.c and files.c (workers), logs.c (log reading and following), admin_api.c (operators),
+ * and the JSON helpers they share (api_json.c). The route table that maps paths to these lives in
+ * http.c.
+ */
+#ifndef PORO_API_H
+#define PORO_API_H
+
+#include "http.h"
+
+/* users */
+void jobs_submit(struct request *r);
+void jobs_list(struct request *r);
+void jobs_show(struct request *r);
+void jobs_cancel(struct request *r);
+void jobs_probes(struct request *r);
+void logs_get(struct request *r);
+void files_get(struct request *r);
+
+/* workers */
+void worker_claim(struct request *r);
+void worker_heartbeat(struct request *r);
+void worker_log(struct request *r);
+void worker_finish(struct request *r);
+void worker_file_get(struct request *r);
+void files_upload_begin(struct request *r);
+int files_upload_data(struct request *r, const char *data, size_t size);
+void files_upload_end(struct request *r);
+void files_upload_abort(struct request *r);
+
+/* operators */
+void admin_healthz(struct request *r);
+void admin_metrics(struct request *r);
+void admin_users_create(struct request *r);
+void admin_tokens_create(struct request *r);
+
+/* ---- request-body helpers (api_json.c) ---- */
+/* The body as a JSON object; NULL after replying 400 invalid_json (with jansson's line and column). */
+json_t *api_body_object(struct request *r);
+/* Refuses keys of obj not in the NULL-terminated list: 0, or -1 after replying 422 naming the key. */
+int api_known_keys(struct request *r, json_t *obj, const char *const *keys);
+/* Optional integer member in [min, max] (default def when absent or null); -1 after replying 422. */
+int api_int_member(struct request *r, json_t *obj, const char *key, long long min, long long max, long long def,
+		   long long *out);
+/* Optional string member of 1..max bytes without control characters (NULL when absent or null, or
+ * when required is 0); -1 after replying 422. */
+int api_string_member(struct request *r, json_t *obj, const char *key, size_t max, int required, const char **out);
+/* A query parameter as an integer in [min, max], default def: 0, or -1 after replying 400. */
+int api_query_int(struct request *r, const char *name, long long min, long long max, long long def, long long *out);
+/* File names: ^[A-Za-z0-9][A-Za-z0-9._-]{0,127}$ and no "..". Decodes the raw path element into
+ * out[129]; 0, or -1 after replying 400 invalid_file_name. */
+int api_file_name(struct request *r, const char *raw, char out[129]);
+
+#endif

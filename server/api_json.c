@@ -1,0 +1,139 @@
+/*
+ * api_json.c - checks of request bodies, query parameters and file names shared by the handlers
+ * (api.h). Each check replies with the error itself (400 for malformed input, 422 naming the JSON
+ * pointer of a schema violation) and returns -1, so handlers read `if (check(...)) return;`.
+ */
+#include "api.h"
+
+#include <stdlib.h>
+#include <string.h>
+
+json_t *api_body_object(struct request *r)
+{
+	json_error_t je;
+	if (!r->body || r->body_size == 0) {
+		reply_fail(r, API_INVALID_JSON, "", "request body is empty: expected a JSON object");
+		return NULL;
+	}
+	json_t *v = json_loadb(r->body, r->body_size, JSON_REJECT_DUPLICATES, &je);
+	if (!v) {
+		reply_fail(r, API_INVALID_JSON, "", "request body is not valid JSON: line %d column %d: %s", je.line,
+			   je.column, je.text);
+		return NULL;
+	}
+	if (!json_is_object(v)) {
+		json_decref(v);
+		reply_fail(r, API_INVALID_JSON, "", "request body must be a JSON object");
+		return NULL;
+	}
+	return v;
+}
+
+int api_known_keys(struct request *r, json_t *obj, const char *const *keys)
+{
+	const char *key;
+	json_t *value;
+	json_object_foreach(obj, key, value) {
+		int known = 0;
+		for (const char *const *k = keys; *k && !known; k++)
+			known = strcmp(*k, key) == 0;
+		if (!known) {
+			/* keys are JSON text: show at most a short, safe prefix */
+			char field[SERVER_FIELD_MAX];
+			snprintf(field, sizeof field, "/%.100s", key);
+			reply_fail(r, API_INVALID_REQUEST, field, "unknown key '%.100s'", key);
+			return -1;
+		}
+	}
+	return 0;
+}
+
+int api_int_member(struct request *r, json_t *obj, const char *key, long long min, long long max, long long def,
+		   long long *out)
+{
+	json_t *v = json_object_get(obj, key);
+	char field[SERVER_FIELD_MAX];
+	snprintf(field, sizeof field, "/%s", key);
+	if (!v || json_is_null(v)) {
+		*out = def;
+		return 0;
+	}
+	if (!json_is_integer(v)) {
+		reply_fail(r, API_INVALID_REQUEST, field, "'%s' must be an integer", key);
+		return -1;
+	}
+	*out = json_integer_value(v);
+	if (*out < min || *out > max) {
+		reply_fail(r, API_INVALID_REQUEST, field, "'%s' must be in %lld..%lld, got %lld", key, min, max, *out);
+		return -1;
+	}
+	return 0;
+}
+
+int api_string_member(struct request *r, json_t *obj, const char *key, size_t max, int required, const char **out)
+{
+	json_t *v = json_object_get(obj, key);
+	char field[SERVER_FIELD_MAX];
+	snprintf(field, sizeof field, "/%s", key);
+	*out = NULL;
+	if (!v || json_is_null(v)) {
+		if (required) {
+			reply_fail(r, API_INVALID_REQUEST, field, "missing required key '%s'", key);
+			return -1;
+		}
+		return 0;
+	}
+	if (!json_is_string(v)) {
+		reply_fail(r, API_INVALID_REQUEST, field, "'%s' must be a string", key);
+		return -1;
+	}
+	const char *s = json_string_value(v);
+	size_t n = json_string_length(v);
+	if (n == 0 || n > max || strlen(s) != n) {
+		reply_fail(r, API_INVALID_REQUEST, field, "'%s' must be 1..%zu bytes without NUL", key, max);
+		return -1;
+	}
+	for (size_t i = 0; i < n; i++)
+		if ((unsigned char)s[i] < 0x20 && s[i] != '\t') {
+			reply_fail(r, API_INVALID_REQUEST, field, "'%s' must not contain control characters", key);
+			return -1;
+		}
+	*out = s;
+	return 0;
+}
+
+int api_query_int(struct request *r, const char *name, long long min, long long max, long long def, long long *out)
+{
+	char text[32];
+	int have = http_query(r, name, text, sizeof text);
+	*out = def;
+	if (have == 0)
+		return 0;
+	char *end = NULL;
+	long long v = have > 0 && text[0] ? strtoll(text, &end, 10) : 0;
+	if (have < 0 || !text[0] || *end || v < min || v > max) {
+		reply_fail(r, API_INVALID_PARAMETER, name, "query parameter '%s' must be an integer in %lld..%lld", name,
+			   min, max);
+		return -1;
+	}
+	*out = v;
+	return 0;
+}
+
+#define FILE_NAME_MAX 128
+
+int api_file_name(struct request *r, const char *raw, char out[FILE_NAME_MAX + 1])
+{
+	int ok = raw && http_decode(raw, out, FILE_NAME_MAX + 1) == 0 && out[0] && strstr(out, "..") == NULL;
+	for (size_t i = 0; ok && out[i]; i++) {
+		char c = out[i];
+		int alnum = (c >= 'A' && c <= 'Z') || (c >= 'a' && c <= 'z') || (c >= '0' && c <= '9');
+		ok = alnum || (i > 0 && (c == '.' || c == '_' || c == '-'));
+	}
+	if (!ok) {
+		reply_fail(r, API_INVALID_FILE_NAME, "name",
+			   "file name must match ^[A-Za-z0-9][A-Za-z0-9._-]{0,127}$ and not contain '..'");
+		return -1;
+	}
+	return 0;
+}

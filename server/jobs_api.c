@@ -1,0 +1,295 @@
+/*
+ * jobs_api.c - the users' job routes (docs/service.md §3 "Users"): submit, list, show, cancel,
+ * probes (read from the job's latest result.h5 through the solver's results reader).
+ *
+ * A submission is checked completely before anything is stored: the request keys and ranges
+ * (422 naming the key), then the case with the solver's own loader, case_load_string(), whose
+ * "JSON-pointer: message" lines become problems [{"field": "/case<pointer>", "message"}] (422
+ * invalid_case). The case is stored in canonical form (json_dumps with JSON_COMPACT |
+ * JSON_SORT_KEYS), and case_sha256 is the SHA-256 of that text. The idempotency comparison uses
+ * the SHA-256 of the whole request in the same canonical form, so key order and white space do
+ * not make two identical requests differ.
+ */
+#include "api.h"
+#include "store.h"
+
+#include "case.h"
+#include "digest.h"
+#include "results_read.h"
+
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#define PRIORITY_MIN -100
+#define PRIORITY_MAX 100
+#define THREADS_MAX 256
+#define WALL_TIME_MAX 2592000LL           /* s, 30 days */
+#define WALL_TIME_DEFAULT 86400           /* s */
+#define IDEMPOTENCY_KEY_MAX 200
+#define LIST_LIMIT_MAX 1000
+#define LIST_LIMIT_DEFAULT 100
+#define ID_MAX 999999999999999999LL
+
+/* Turns the loader's "pointer: message" lines into problems under /case. */
+static json_t *case_problems(const char *message)
+{
+	json_t *problems = json_array();
+	const char *line = message;
+	while (line && *line) {
+		const char *end = strchr(line, '\n');
+		size_t n = end ? (size_t)(end - line) : strlen(line);
+		const char *sep = memchr(line, ':', n);
+		char field[SERVER_FIELD_MAX] = "/case";
+		const char *text = line;
+		size_t text_n = n;
+		if (sep && line[0] == '/') {
+			size_t pn = (size_t)(sep - line);
+			if (!(pn == 1 && line[0] == '/'))  /* "/" is the whole case */
+				snprintf(field, sizeof field, "/case%.*s", (int)pn, line);
+			text = sep + 1;
+			text_n = n - pn - 1;
+			while (text_n && *text == ' ') {
+				text++;
+				text_n--;
+			}
+		}
+		if (n)
+			json_array_append_new(problems, json_pack("{s:s, s:s%}", "field", field, "message", text, text_n));
+		line = end ? end + 1 : NULL;
+	}
+	return problems;
+}
+
+static int check_case(struct request *r, json_t *case_spec, char **canonical)
+{
+	*canonical = json_dumps(case_spec, JSON_COMPACT | JSON_SORT_KEYS);
+	if (!*canonical) {
+		reply_fail(r, API_INTERNAL, "", "cannot encode the case");
+		return -1;
+	}
+	struct case_spec *loaded = NULL;
+	struct poro_error *perr = calloc(1, sizeof *perr);
+	if (!perr) {
+		reply_fail(r, API_INTERNAL, "", "out of memory");
+		return -1;
+	}
+	enum poro_status st = case_load_string(*canonical, &loaded, perr);
+	case_destroy(&loaded);
+	if (st == PORO_OK) {
+		free(perr);
+		return 0;
+	}
+	struct api_error err = { 0 };
+	api_fail(&err, st == PORO_EINVAL ? API_INVALID_CASE : API_INTERNAL, "/case", "case is invalid");
+	err.problems = case_problems(perr->message);
+	if (json_array_size(err.problems) > 0) {
+		json_t *first = json_array_get(err.problems, 0);
+		snprintf(err.field, sizeof err.field, "%s", json_string_value(json_object_get(first, "field")));
+		snprintf(err.message, sizeof err.message, "case is invalid: %zu problem%s, first: %s",
+			 json_array_size(err.problems), json_array_size(err.problems) > 1 ? "s" : "",
+			 json_string_value(json_object_get(first, "message")));
+	}
+	free(perr);
+	reply_error(r, &err);
+	return -1;
+}
+
+static int idempotency_key(struct request *r, const char **key)
+{
+	*key = http_header(r, "Idempotency-Key");
+	if (!*key)
+		return 0;
+	size_t n = strlen(*key);
+	int ok = n >= 1 && n <= IDEMPOTENCY_KEY_MAX;
+	for (size_t i = 0; ok && i < n; i++)
+		ok = (*key)[i] > 0x20 && (*key)[i] < 0x7f;
+	if (!ok) {
+		reply_fail(r, API_INVALID_HEADER, "Idempotency-Key",
+			   "Idempotency-Key must be 1..%d visible ASCII characters", IDEMPOTENCY_KEY_MAX);
+		return -1;
+	}
+	return 0;
+}
+
+void jobs_submit(struct request *r)
+{
+	static const char *const keys[] = { "case", "priority", "threads", "wall_time_seconds", "name", NULL };
+	json_t *body = api_body_object(r);
+	if (!body)
+		return;
+	long long priority, threads, wall;
+	const char *name, *key;
+	char *canonical = NULL, *whole = NULL;
+	json_t *case_spec = json_object_get(body, "case");
+	if (api_known_keys(r, body, keys) || idempotency_key(r, &key))
+		goto done;
+	if (!json_is_object(case_spec)) {
+		reply_fail(r, API_INVALID_REQUEST, "/case", case_spec ? "'case' must be an object" : "missing required key 'case'");
+		goto done;
+	}
+	if (api_int_member(r, body, "priority", PRIORITY_MIN, PRIORITY_MAX, 0, &priority) ||
+	    api_int_member(r, body, "threads", 1, THREADS_MAX, 1, &threads) ||
+	    api_int_member(r, body, "wall_time_seconds", 1, WALL_TIME_MAX, WALL_TIME_DEFAULT, &wall) ||
+	    api_string_member(r, body, "name", SERVER_NAME_MAX, 0, &name) || check_case(r, case_spec, &canonical))
+		goto done;
+	whole = json_dumps(body, JSON_COMPACT | JSON_SORT_KEYS);
+	char case_sha[DIGEST_HEX_SIZE], body_sha[DIGEST_HEX_SIZE];
+	digest_hex(canonical, strlen(canonical), case_sha);
+	digest_hex(whole ? whole : "", whole ? strlen(whole) : 0, body_sha);
+	struct job_submit in = { .who = &r->who, .idempotency_key = key, .body_sha256 = body_sha,
+				 .case_json = canonical, .case_sha256 = case_sha, .name = name,
+				 .priority = (int)priority, .threads = (int)threads,
+				 .wall_time_seconds = (int)wall };
+	json_t *job = NULL;
+	int created = 0;
+	struct api_error err = { 0 };
+	if (store_job_submit(r->srv->store, &in, &job, &created, &err) != API_OK) {
+		reply_error(r, &err);
+		goto done;
+	}
+	char location[64];
+	snprintf(location, sizeof location, "/v1/jobs/%lld", (long long)json_integer_value(json_object_get(job, "id")));
+	reply_header(r, "Location", location);
+	reply_json(r, created ? 201 : 200, job);
+done:
+	free(canonical);
+	free(whole);
+	json_decref(body);
+}
+
+static int parse_states(struct request *r, unsigned *mask)
+{
+	char text[256];
+	int have = http_query(r, "state", text, sizeof text);
+	*mask = 0;
+	if (have == 0)
+		return 0;
+	char *save = NULL;
+	for (char *tok = have > 0 ? strtok_r(text, ",", &save) : NULL; tok; tok = strtok_r(NULL, ",", &save)) {
+		enum job_state st;
+		if (job_state_parse(tok, &st) != 0) {
+			have = -1;
+			break;
+		}
+		*mask |= 1u << st;
+	}
+	if (have < 0 || *mask == 0) {
+		reply_fail(r, API_INVALID_PARAMETER, "state",
+			   "query parameter 'state' must be a comma-separated list of queued, running, succeeded, "
+			   "failed, cancelled");
+		return -1;
+	}
+	return 0;
+}
+
+void jobs_list(struct request *r)
+{
+	unsigned states;
+	long long limit, after;
+	if (parse_states(r, &states) || api_query_int(r, "limit", 1, LIST_LIMIT_MAX, LIST_LIMIT_DEFAULT, &limit) ||
+	    api_query_int(r, "after", 1, ID_MAX, 0, &after))
+		return;
+	json_t *page = NULL;
+	struct api_error err = { 0 };
+	if (store_job_list(r->srv->store, &r->who, states, (int)limit, after, &page, &err) != API_OK) {
+		reply_error(r, &err);
+		return;
+	}
+	reply_json(r, 200, page);
+}
+
+void jobs_show(struct request *r)
+{
+	json_t *job = NULL;
+	struct api_error err = { 0 };
+	if (store_job_get(r->srv->store, &r->who, r->id, 1, &job, &err) != API_OK) {
+		reply_error(r, &err);
+		return;
+	}
+	reply_json(r, 200, job);
+}
+
+void jobs_cancel(struct request *r)
+{
+	if (r->body_size) {
+		json_t *body = api_body_object(r);
+		static const char *const none[] = { NULL };
+		int bad = !body || api_known_keys(r, body, none);
+		json_decref(body);
+		if (bad)
+			return;
+	}
+	json_t *job = NULL;
+	struct api_error err = { 0 };
+	if (store_job_cancel(r->srv->store, &r->who, r->id, &job, &err) != API_OK) {
+		reply_error(r, &err);
+		return;
+	}
+	reply_json(r, 200, job);
+}
+
+/* Adds {"unit", "time", "value"} of probe `name` to out, or records why it cannot. */
+static int add_probe(struct results *res, const char *name, json_t *out, struct poro_error *perr)
+{
+	double *t = NULL, *v = NULL;
+	char *units = NULL;
+	long n = 0;
+	if (results_probe_read(res, name, &t, &v, &n, &units, perr))
+		return -1;
+	json_t *times = json_array(), *values = json_array();
+	for (long k = 0; k < n; k++) {
+		json_array_append_new(times, json_real(t[k]));
+		json_array_append_new(values, json_real(v[k]));
+	}
+	json_object_set_new(out, name, json_pack("{s:s, s:o, s:o}", "unit", units ? units : "", "time", times,
+						 "value", values));
+	free(t), free(v), free(units);
+	return 0;
+}
+
+/* The probe series of the job's latest result.h5, for plots: {"job", "attempt", "probes": {name: {"unit",
+ * "time", "value"}}} with names in the order of the case. A job without a result file yet is 404. */
+void jobs_probes(struct request *r)
+{
+	json_t *job = NULL;
+	struct api_error err = { 0 };
+	if (store_job_get(r->srv->store, &r->who, r->id, 0, &job, &err) != API_OK) {
+		reply_error(r, &err);
+		return;
+	}
+	json_decref(job);
+	int attempt;
+	long long size;
+	char sha[DIGEST_HEX_SIZE], path[SERVER_PATH_MAX];
+	if (store_file_find(r->srv->store, r->id, "result.h5", -1, &attempt, &size, sha, &err) != API_OK) {
+		reply_fail(r, API_NOT_FOUND, "", "job %lld has no result.h5 yet", r->id);
+		return;
+	}
+	snprintf(path, sizeof path, "%s/files/%lld/%d/result.h5", r->srv->cfg.state, r->id, attempt);
+	struct results *res = NULL;
+	struct poro_error perr = { 0 };
+	if (results_open(&res, path, &perr)) {
+		reply_fail(r, API_INTERNAL, "", "cannot read the result of job %lld: %s", r->id, perr.message);
+		return;
+	}
+	json_t *the_case = json_loads(results_case_json(res), 0, NULL);
+	json_t *list = json_object_get(the_case, "probes"), *probes = json_object(), *item;
+	size_t i;
+	int failed = 0;
+	json_array_foreach(list, i, item) {
+		const char *name = json_string_value(json_object_get(item, "name"));
+		if (name && add_probe(res, name, probes, &perr) < 0) {
+			failed = 1;
+			break;
+		}
+	}
+	json_decref(the_case);
+	results_close(&res);
+	if (failed) {
+		json_decref(probes);
+		reply_fail(r, API_INTERNAL, "", "cannot read the probes of job %lld: %s", r->id, perr.message);
+		return;
+	}
+	reply_json(r, 200, json_pack("{s:I, s:i, s:o}", "job", (json_int_t)r->id, "attempt", attempt, "probes", probes));
+}

@@ -1,0 +1,329 @@
+/*
+ * main.c - the poro-server program: configuration from a file and flags (flags win), the
+ * `token create` set-up subcommand, start-up (state directory, database, HTTP, reaper, the URL
+ * written atomically to STATE/server.url) and orderly shutdown on SIGTERM or SIGINT: stop
+ * accepting, let in-flight requests finish (their writes commit), end long-polls and followed
+ * logs, stop the writer, close the database, exit 0.
+ *
+ * Every option is one row of OPTIONS: the flag name, which is also the key in the config file
+ * ("name = value" lines, '#' comments), the field it sets, its default and its help text.
+ */
+#include "http.h"
+#include "metrics.h"
+#include "reaper.h"
+#include "store.h"
+
+#include "digest.h"
+
+#include <errno.h>
+#include <fcntl.h>
+#include <signal.h>
+#include <stddef.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+enum option_type { OPT_TEXT, OPT_INT, OPT_LONG };
+
+struct option_def {
+	const char *name;
+	enum option_type type;
+	size_t offset;           /* in struct server_config */
+	size_t size;             /* OPT_TEXT: buffer size */
+	long long min, max;
+	const char *help;
+};
+
+#define TEXT_OPT(n, f, h) { n, OPT_TEXT, offsetof(struct server_config, f), sizeof((struct server_config *)0)->f, 0, 0, h }
+#define INT_OPT(n, f, lo, hi, h) { n, OPT_INT, offsetof(struct server_config, f), 0, lo, hi, h }
+#define LONG_OPT(n, f, lo, hi, h) { n, OPT_LONG, offsetof(struct server_config, f), 0, lo, hi, h }
+
+static const struct option_def OPTIONS[] = {
+	TEXT_OPT("listen", listen, "HOST:PORT to listen on; port 0 picks a free one (default 127.0.0.1:8080)"),
+	TEXT_OPT("state", state, "state directory: poro.db, files/, server.url (default ./var)"),
+	INT_OPT("max-connections", max_connections, 1, 100000, "concurrent HTTP connections, one thread each (default 512)"),
+	LONG_OPT("max-body-bytes", max_body_bytes, 1024, 1LL << 40, "largest JSON request body (default 4194304)"),
+	LONG_OPT("max-upload-bytes", max_upload_bytes, 1, 1LL << 50, "largest uploaded file (default 4294967296)"),
+	INT_OPT("lease-seconds", lease_seconds, 1, 86400, "lease length; each heartbeat renews it (default 30)"),
+	INT_OPT("max-attempts", max_attempts, 1, 1000, "attempts before an infrastructure failure is final (default 5)"),
+	INT_OPT("user-max-queued", user_max_queued, 1, 100000000, "default per-user cap on queued jobs (default 10000)"),
+	INT_OPT("user-max-running", user_max_running, 0, 100000000, "default per-user cap on running jobs, 0 = unlimited (default 0)"),
+	INT_OPT("max-backoff-seconds", max_backoff_seconds, 1, 86400, "cap of the retry backoff min(2^(attempt-1), cap) (default 60)"),
+	INT_OPT("group-commit-max", group_commit_max, 1, 100000, "most write requests in one transaction (default 1024)"),
+};
+#define OPTION_COUNT (sizeof OPTIONS / sizeof OPTIONS[0])
+
+static const struct server_config CONFIG_DEFAULTS = {
+	.listen = "127.0.0.1:8080", .state = "./var", .max_connections = 512, .max_body_bytes = 4LL << 20,
+	.max_upload_bytes = 4LL << 30, .lease_seconds = 30, .max_attempts = 5, .user_max_queued = 10000,
+	.user_max_running = 0, .max_backoff_seconds = 60, .group_commit_max = 1024,
+};
+
+static void usage(FILE *out)
+{
+	fprintf(out, "usage: poro-server [--config FILE] [--OPTION VALUE ...]\n"
+		     "       poro-server token create --state DIR --user NAME --role user|worker|admin\n\n"
+		     "The HTTP job server of PoroMPM (docs/service.md). Every option may also be a line\n"
+		     "'name = value' in the config file; flags win over the file.\n\n"
+		     "options:\n  --config FILE  read options from FILE\n");
+	for (size_t i = 0; i < OPTION_COUNT; i++)
+		fprintf(out, "  --%-20s %s\n", OPTIONS[i].name, OPTIONS[i].help);
+	fprintf(out, "  --help                 this text\n  --version              print the version\n");
+}
+
+static int set_option(struct server_config *cfg, const char *name, const char *value, const char *where)
+{
+	for (size_t i = 0; i < OPTION_COUNT; i++) {
+		const struct option_def *o = &OPTIONS[i];
+		if (strcmp(o->name, name) != 0)
+			continue;
+		char *field = (char *)cfg + o->offset;
+		if (o->type == OPT_TEXT) {
+			if (strlen(value) >= o->size || !value[0]) {
+				fprintf(stderr, "poro-server: %s: value of '%s' is empty or too long\n", where, name);
+				return -1;
+			}
+			memcpy(field, value, strlen(value) + 1);
+			return 0;
+		}
+		char *end;
+		errno = 0;
+		long long v = strtoll(value, &end, 10);
+		if (errno || end == value || *end || v < o->min || v > o->max) {
+			fprintf(stderr, "poro-server: %s: '%s' must be an integer in %lld..%lld, got '%s'\n", where, name,
+				o->min, o->max, value);
+			return -1;
+		}
+		if (o->type == OPT_INT)
+			*(int *)(void *)field = (int)v;
+		else
+			*(long long *)(void *)field = v;
+		return 0;
+	}
+	fprintf(stderr, "poro-server: %s: unknown option '%s'\n", where, name);
+	return -1;
+}
+
+static char *trim(char *s)
+{
+	while (*s == ' ' || *s == '\t')
+		s++;
+	size_t n = strlen(s);
+	while (n && (s[n - 1] == ' ' || s[n - 1] == '\t' || s[n - 1] == '\n' || s[n - 1] == '\r'))
+		s[--n] = '\0';
+	return s;
+}
+
+static int read_config(struct server_config *cfg, const char *path)
+{
+	FILE *f = fopen(path, "r");
+	if (!f) {
+		fprintf(stderr, "poro-server: cannot open config file '%s': %s\n", path, strerror(errno));
+		return -1;
+	}
+	char line[8192], where[SERVER_PATH_MAX + 32];
+	int number = 0, rc = 0;
+	while (rc == 0 && fgets(line, sizeof line, f)) {
+		number++;
+		char *s = trim(line);
+		if (!*s || *s == '#')
+			continue;
+		char *eq = strchr(s, '=');
+		snprintf(where, sizeof where, "%s:%d", path, number);
+		if (!eq) {
+			fprintf(stderr, "poro-server: %s: expected 'name = value'\n", where);
+			rc = -1;
+			break;
+		}
+		*eq = '\0';
+		rc = set_option(cfg, trim(s), trim(eq + 1), where);
+	}
+	fclose(f);
+	return rc;
+}
+
+/* Config file first (wherever --config appears), then the flags over it. */
+static int parse_args(struct server_config *cfg, int argc, char **argv)
+{
+	*cfg = CONFIG_DEFAULTS;
+	for (int i = 1; i < argc; i++)
+		if (strcmp(argv[i], "--config") == 0) {
+			if (i + 1 >= argc || read_config(cfg, argv[i + 1]) != 0)
+				return i + 1 >= argc ? (fprintf(stderr, "poro-server: --config needs a file\n"), -1) : -1;
+			i++;
+		}
+	for (int i = 1; i < argc; i++) {
+		const char *a = argv[i];
+		if (strcmp(a, "--help") == 0 || strcmp(a, "-h") == 0) {
+			usage(stdout);
+			exit(0);
+		}
+		if (strcmp(a, "--version") == 0) {
+			printf("poro-server %s\n", PORO_VERSION);
+			exit(0);
+		}
+		if (strncmp(a, "--", 2) != 0 || i + 1 >= argc) {
+			fprintf(stderr, "poro-server: unexpected argument '%s' (see --help)\n", a);
+			return -1;
+		}
+		if (strcmp(a, "--config") != 0 && set_option(cfg, a + 2, argv[i + 1], "command line") != 0)
+			return -1;
+		i++;
+	}
+	return 0;
+}
+
+static int make_dir(const char *path)
+{
+	char buf[SERVER_PATH_MAX];
+	snprintf(buf, sizeof buf, "%s", path);
+	for (char *p = buf + 1; *p; p++)
+		if (*p == '/') {
+			*p = '\0';
+			if (mkdir(buf, 0755) != 0 && errno != EEXIST)
+				return -1;
+			*p = '/';
+		}
+	return mkdir(buf, 0755) != 0 && errno != EEXIST ? -1 : 0;
+}
+
+static int open_store(struct server_config *cfg, struct server *srv, struct store **store)
+{
+	char path[SERVER_PATH_MAX + 16];
+	if (make_dir(cfg->state) != 0) {
+		fprintf(stderr, "poro-server: cannot create state directory '%s': %s\n", cfg->state, strerror(errno));
+		return -1;
+	}
+	snprintf(path, sizeof path, "%s/poro.db", cfg->state);
+	struct api_error err = { 0 };
+	if (store_open(store, path, cfg, srv, &err) != API_OK) {
+		fprintf(stderr, "poro-server: %s\n", err.message);
+		return -1;
+	}
+	return 0;
+}
+
+static int token_create(int argc, char **argv)
+{
+	struct server_config cfg = CONFIG_DEFAULTS;
+	const char *user = NULL, *role_text = NULL;
+	for (int i = 3; i < argc; i += 2) {
+		const char *v = i + 1 < argc ? argv[i + 1] : NULL;
+		if (!v) {
+			fprintf(stderr, "poro-server: token create: '%s' needs a value\n", argv[i]);
+			return 2;
+		}
+		if (strcmp(argv[i], "--state") == 0 && strlen(v) < sizeof cfg.state)
+			snprintf(cfg.state, sizeof cfg.state, "%s", v);
+		else if (strcmp(argv[i], "--user") == 0)
+			user = v;
+		else if (strcmp(argv[i], "--role") == 0)
+			role_text = v;
+		else {
+			fprintf(stderr, "poro-server: token create: unknown argument '%s'\n", argv[i]);
+			return 2;
+		}
+	}
+	enum role role;
+	if (!user || !user[0] || strlen(user) > SERVER_NAME_MAX || !role_text || role_parse(role_text, &role) != 0) {
+		fprintf(stderr, "poro-server: token create needs --user NAME and --role user|worker|admin\n");
+		return 2;
+	}
+	struct store *store = NULL;
+	if (open_store(&cfg, NULL, &store) != 0)
+		return 1;
+	char token[DIGEST_TOKEN_SIZE], hash[DIGEST_HEX_SIZE];
+	struct api_error err = { 0 };
+	int rc = 0;
+	if (digest_new_token(token) != 0) {
+		fprintf(stderr, "poro-server: no randomness available for a token\n");
+		rc = 1;
+	} else {
+		digest_hex(token, strlen(token), hash);
+		if (store_token_add(store, user, (int)role, hash, &err) != API_OK) {
+			fprintf(stderr, "poro-server: cannot create a token for '%s': %s\n", user, err.message);
+			rc = 1;
+		}
+	}
+	store_close(&store);
+	if (rc == 0)
+		printf("%s\n", token);
+	return rc;
+}
+
+/* Writes the URL to STATE/server.url through a temporary file and a rename. */
+static int write_url(const char *state, const char *url)
+{
+	char tmp[SERVER_PATH_MAX + 32], path[SERVER_PATH_MAX + 32];
+	snprintf(tmp, sizeof tmp, "%s/server.url.tmp", state);
+	snprintf(path, sizeof path, "%s/server.url", state);
+	int fd = open(tmp, O_WRONLY | O_CREAT | O_TRUNC, 0644);
+	if (fd < 0)
+		return -1;
+	size_t n = strlen(url);
+	int ok = write(fd, url, n) == (ssize_t)n && write(fd, "\n", 1) == 1 && fsync(fd) == 0;
+	ok = close(fd) == 0 && ok;
+	return ok && rename(tmp, path) == 0 ? 0 : -1;
+}
+
+static int serve(struct server *srv)
+{
+	sigset_t signals;
+	sigemptyset(&signals);
+	sigaddset(&signals, SIGTERM);
+	sigaddset(&signals, SIGINT);
+	/* Blocked in every thread created from here on; main waits for them with sigwait. */
+	pthread_sigmask(SIG_BLOCK, &signals, NULL);
+	signal(SIGPIPE, SIG_IGN);
+	if (open_store(&srv->cfg, srv, &srv->store) != 0)
+		return 1;
+	store_set_commit_observer(srv->store, metrics_observe_commit, srv->metrics);
+	char url[512], msg[SERVER_MESSAGE_MAX];
+	void *daemon = http_start(srv, url, sizeof url, msg, sizeof msg);
+	if (!daemon) {
+		fprintf(stderr, "poro-server: %s\n", msg);
+		store_close(&srv->store);
+		return 1;
+	}
+	if (write_url(srv->cfg.state, url) != 0)
+		fprintf(stderr, "poro-server: cannot write '%s/server.url': %s\n", srv->cfg.state, strerror(errno));
+	struct reaper *reaper = reaper_start(srv);
+	printf("poro-server listening on %s\n", url);
+	fflush(stdout);
+
+	int sig = 0;
+	sigwait(&signals, &sig);
+	http_quiesce(daemon);
+	pthread_mutex_lock(&srv->wake_lock);
+	srv->stopping = 1;
+	pthread_cond_broadcast(&srv->claim_cv);
+	pthread_cond_broadcast(&srv->log_cv);
+	pthread_mutex_unlock(&srv->wake_lock);
+	reaper_stop(&reaper);
+	http_stop(daemon);          /* waits for in-flight requests, whose writes commit first */
+	store_close(&srv->store);   /* drains the writer, checkpoints, closes */
+	fprintf(stderr, "poro-server: stopped on signal %d\n", sig);
+	return 0;
+}
+
+int main(int argc, char **argv)
+{
+	if (argc >= 3 && strcmp(argv[1], "token") == 0 && strcmp(argv[2], "create") == 0)
+		return token_create(argc, argv);
+	static struct server srv;
+	if (parse_args(&srv.cfg, argc, argv) != 0)
+		return 2;
+	pthread_mutex_init(&srv.wake_lock, NULL);
+	pthread_cond_init(&srv.claim_cv, NULL);
+	pthread_cond_init(&srv.log_cv, NULL);
+	srv.metrics = metrics_create();
+	if (!srv.metrics) {
+		fprintf(stderr, "poro-server: out of memory\n");
+		return 1;
+	}
+	int rc = serve(&srv);
+	metrics_destroy(&srv.metrics);
+	return rc;
+}

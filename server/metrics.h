@@ -1,0 +1,26 @@
+/*
+ * metrics.h - the server's Prometheus metrics (docs/service.md §4): counters and histograms kept
+ * in memory by the handlers and the writer, and the text exposition format for GET /metrics.
+ * Job counts per state are read from the database at scrape time. Thread-safe.
+ */
+#ifndef PORO_METRICS_H
+#define PORO_METRICS_H
+
+#include "server.h"
+
+struct metrics *metrics_create(void);             /* NULL when out of memory */
+void metrics_destroy(struct metrics **m);
+
+void metrics_count_request(struct metrics *m, int status);
+void metrics_observe_claim_latency(struct metrics *m, double seconds);
+void metrics_observe_job_duration(struct metrics *m, double seconds);
+void metrics_observe_commit(void *m, double seconds);   /* a store commit observer (store.h) */
+void metrics_add_lease_expiries(struct metrics *m, int n);
+void metrics_add_retries(struct metrics *m, int n);
+/* Records a heartbeat (or claim) of a worker id for poro_worker_heartbeat_age_seconds. */
+void metrics_worker_seen(struct metrics *m, const char *worker);
+
+/* The exposition text (malloc'ed) with job counts from the store; NULL when out of memory. */
+char *metrics_render(struct metrics *m, struct store *store, size_t *size);
+
+#endif

@@ -1,0 +1,142 @@
+/*
+ * migrations.c - the versioned database schema of poro-server.
+ *
+ * MIGRATIONS is an ordered list; migration i (1-based) brings the schema from version i - 1 to i.
+ * The table schema_migrations records each applied version with its time. On open, every
+ * migration newer than the database is applied in one transaction, so a crash mid-way leaves the
+ * old version intact. A database whose version is newer than the binary knows is refused: an old
+ * binary must not write into a schema it does not understand. Append new migrations at the end;
+ * never edit one that has shipped.
+ *
+ * Times are milliseconds since the epoch (INTEGER). users.queued and users.running are counters
+ * kept by job_transition() (store_jobs.c) so that quota checks and fair share need no scans.
+ */
+#include "store_internal.h"
+
+#include <stdio.h>
+
+static const char *const MIGRATIONS[] = {
+	/* 1: users, tokens, jobs, events, idempotency keys, log chunks, file index */
+	"CREATE TABLE users ("
+	"  id INTEGER PRIMARY KEY,"
+	"  name TEXT NOT NULL UNIQUE,"
+	"  role TEXT NOT NULL CHECK (role IN ('user', 'worker', 'admin')),"
+	"  max_queued INTEGER,"            /* NULL: the server default */
+	"  max_running INTEGER,"
+	"  queued INTEGER NOT NULL DEFAULT 0,"
+	"  running INTEGER NOT NULL DEFAULT 0,"
+	"  last_claim_seq INTEGER NOT NULL DEFAULT 0," /* round robin among users with equal running */
+	"  created_at INTEGER NOT NULL);"
+	"CREATE TABLE tokens ("
+	"  sha256 TEXT PRIMARY KEY,"
+	"  user_id INTEGER NOT NULL REFERENCES users(id),"
+	"  created_at INTEGER NOT NULL) WITHOUT ROWID;"
+	"CREATE TABLE jobs ("
+	"  id INTEGER PRIMARY KEY,"
+	"  user_id INTEGER NOT NULL REFERENCES users(id),"
+	"  name TEXT,"
+	"  state TEXT NOT NULL,"
+	"  priority INTEGER NOT NULL,"
+	"  threads INTEGER NOT NULL,"
+	"  wall_time_seconds INTEGER NOT NULL,"
+	"  attempt INTEGER NOT NULL DEFAULT 0,"
+	"  case_json TEXT NOT NULL,"
+	"  case_sha256 TEXT NOT NULL,"
+	"  created_at INTEGER NOT NULL,"
+	"  queued_at INTEGER NOT NULL,"      /* last time it entered queued, for claim latency */
+	"  not_before INTEGER NOT NULL DEFAULT 0,"
+	"  started_at INTEGER,"              /* claim of the current attempt */
+	"  finished_at INTEGER,"
+	"  lease_expires_at INTEGER,"
+	"  worker TEXT,"                     /* worker id ("host:pid") of the current lease */
+	"  lease_user_id INTEGER,"           /* the worker token's user holding the lease */
+	"  worker_host TEXT,"
+	"  solver_version TEXT,"
+	"  progress TEXT,"
+	"  message TEXT,"
+	"  exit_code INTEGER,"
+	"  cancel_requested INTEGER NOT NULL DEFAULT 0);"
+	"CREATE INDEX jobs_claim ON jobs (user_id, state, priority DESC, id);"
+	"CREATE INDEX jobs_state ON jobs (state, lease_expires_at);"
+	"CREATE TABLE events ("
+	"  id INTEGER PRIMARY KEY,"
+	"  job_id INTEGER NOT NULL REFERENCES jobs(id),"
+	"  at INTEGER NOT NULL,"
+	"  from_state TEXT,"
+	"  to_state TEXT NOT NULL,"
+	"  attempt INTEGER NOT NULL,"
+	"  actor TEXT NOT NULL,"
+	"  detail TEXT);"
+	"CREATE INDEX events_job ON events (job_id, id);"
+	"CREATE TABLE idempotency ("
+	"  user_id INTEGER NOT NULL,"
+	"  key TEXT NOT NULL,"
+	"  body_sha256 TEXT NOT NULL,"
+	"  job_id INTEGER NOT NULL REFERENCES jobs(id),"
+	"  PRIMARY KEY (user_id, key)) WITHOUT ROWID;"
+	"CREATE TABLE log_chunks ("
+	"  job_id INTEGER NOT NULL REFERENCES jobs(id),"
+	"  attempt INTEGER NOT NULL,"
+	"  offset INTEGER NOT NULL,"
+	"  text BLOB NOT NULL,"
+	"  PRIMARY KEY (job_id, attempt, offset)) WITHOUT ROWID;"
+	"CREATE TABLE files ("
+	"  job_id INTEGER NOT NULL REFERENCES jobs(id),"
+	"  attempt INTEGER NOT NULL,"
+	"  name TEXT NOT NULL,"
+	"  size INTEGER NOT NULL,"
+	"  sha256 TEXT NOT NULL,"
+	"  created_at INTEGER NOT NULL,"
+	"  PRIMARY KEY (job_id, name, attempt)) WITHOUT ROWID;",
+};
+
+#define MIGRATION_COUNT ((int)(sizeof MIGRATIONS / sizeof MIGRATIONS[0]))
+
+static enum api_code current_version(struct conn *c, int *version, struct api_error *err)
+{
+	if (conn_exec(c, "CREATE TABLE IF NOT EXISTS schema_migrations ("
+			 " version INTEGER PRIMARY KEY, applied_at INTEGER NOT NULL)") != SQLITE_OK)
+		return db_fail(c, err, "creating schema_migrations");
+	sqlite3_stmt *st = NULL;
+	if (sqlite3_prepare_v2(c->db, "SELECT coalesce(max(version), 0) FROM schema_migrations", -1, &st, NULL)
+	    != SQLITE_OK)
+		return db_fail(c, err, "reading the schema version");
+	int rc = sqlite3_step(st);
+	*version = rc == SQLITE_ROW ? sqlite3_column_int(st, 0) : -1;
+	sqlite3_finalize(st);
+	if (*version < 0)
+		return db_fail(c, err, "reading the schema version");
+	return API_OK;
+}
+
+enum api_code migrations_apply(struct conn *c, struct api_error *err)
+{
+	if (conn_exec(c, "BEGIN IMMEDIATE") != SQLITE_OK)
+		return db_fail(c, err, "locking the database for migrations");
+	int version = 0;
+	enum api_code rc = current_version(c, &version, err);
+	if (rc == API_OK && version > MIGRATION_COUNT)
+		rc = api_fail(err, API_INTERNAL, "",
+			      "database schema version %d is newer than this poro-server knows (%d): "
+			      "use a newer poro-server", version, MIGRATION_COUNT);
+	for (int v = version + 1; rc == API_OK && v <= MIGRATION_COUNT; v++) {
+		char *msg = NULL;
+		if (sqlite3_exec(c->db, MIGRATIONS[v - 1], NULL, NULL, &msg) != SQLITE_OK) {
+			rc = api_fail(err, API_INTERNAL, "", "migration %d failed: %s", v, msg ? msg : "?");
+			sqlite3_free(msg);
+			break;
+		}
+		char sql[128];
+		snprintf(sql, sizeof sql, "INSERT INTO schema_migrations (version, applied_at) VALUES (%d, %lld)", v,
+			 now_ms());
+		if (conn_exec(c, sql) != SQLITE_OK)
+			rc = db_fail(c, err, "recording a migration");
+	}
+	if (rc != API_OK) {
+		conn_exec(c, "ROLLBACK");
+		return rc;
+	}
+	if (conn_exec(c, "COMMIT") != SQLITE_OK)
+		return db_fail(c, err, "committing migrations");
+	return API_OK;
+}

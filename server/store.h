@@ -1,0 +1,129 @@
+/*
+ * store.h - the server's SQLite database (docs/service.md §1): jobs, attempts, events, log chunks,
+ * the artifact index, users and tokens. SQLite enters poro-server only through store*.c and
+ * migrations.c.
+ *
+ * Writes. One writer thread owns the only read-write connection. Every write function below
+ * enqueues a request and blocks until the writer has run it inside a shared BEGIN IMMEDIATE ...
+ * COMMIT (group commit, each request in its own SAVEPOINT so a failing one rolls back alone) and
+ * COMMIT has returned. The database runs in WAL mode with synchronous=FULL, so when a write
+ * function returns API_OK its effect survives kill -9 and power loss: callers may acknowledge.
+ *
+ * Reads use a pool of read-only connections, one per concurrent reader, opened once and reused.
+ *
+ * Every function returns API_OK or an error code recorded in err (server.h). JSON results are new
+ * references the caller owns (json_decref). Times are milliseconds since the epoch.
+ */
+#ifndef PORO_STORE_H
+#define PORO_STORE_H
+
+#include "server.h"
+
+/* Opens (creating if needed) the database at path, applies pending migrations (migrations.c),
+ * refuses a database newer than this binary, and starts the writer thread. Limits come from cfg
+ * (default caps, lease, attempts); cfg must outlive the store. srv may be NULL (token create):
+ * it is used to wake long-polls after commits. */
+enum api_code store_open(struct store **s, const char *path, const struct server_config *cfg,
+			 struct server *srv, struct api_error *err);
+/* Finishes queued writes, stops the writer, checkpoints and closes every connection; accepts NULL. */
+void store_close(struct store **s);
+/* 0 when a read of the database works (for /healthz). */
+int store_ping(struct store *s);
+
+/* ---- users and tokens (store_users.c) ---- */
+/* The principal owning a token, by the token's SHA-256 hex. API_UNAUTHORIZED when unknown. */
+enum api_code store_auth(struct store *s, const char *token_sha256, struct principal *who, struct api_error *err);
+/* Creates a user; max_queued / max_running < 0 mean "the server default". API_ALREADY_EXISTS. */
+enum api_code store_user_create(struct store *s, const char *name, enum role role, int max_queued,
+				int max_running, json_t **user, struct api_error *err);
+/* Stores a token hash for a user; with create_role > 0 the user is created first if missing. */
+enum api_code store_token_add(struct store *s, const char *user, int create_role, const char *token_sha256,
+			      struct api_error *err);
+
+/* ---- jobs, user side (store_jobs.c) ---- */
+struct job_submit {
+	const struct principal *who;
+	const char *idempotency_key;  /* or NULL */
+	const char *body_sha256;      /* canonical request body, for the idempotency comparison */
+	const char *case_json;        /* canonical case text */
+	const char *case_sha256;
+	const char *name;             /* or NULL */
+	int priority, threads, wall_time_seconds;
+};
+/* Stores a queued job and its "submitted" event. *created is 1 for a new job, 0 when the
+ * idempotency key returned an existing one. API_IDEMPOTENCY_CONFLICT, API_QUOTA_EXCEEDED. */
+enum api_code store_job_submit(struct store *s, const struct job_submit *in, json_t **job, int *created,
+			       struct api_error *err);
+/* A job the principal may see (its own; every job for admins), with files and events when full. */
+enum api_code store_job_get(struct store *s, const struct principal *who, long long id, int full, json_t **job,
+			    struct api_error *err);
+/* Newest first; states is a bit mask of JOB_STATE_* (0 = all); after = 0 for the first page. */
+enum api_code store_job_list(struct store *s, const struct principal *who, unsigned states, int limit,
+			     long long after, json_t **page, struct api_error *err);
+/* Cancels a queued job now, or requests cancel of a running one. API_NOT_CANCELLABLE. */
+enum api_code store_job_cancel(struct store *s, const struct principal *who, long long id, json_t **job,
+			       struct api_error *err);
+
+#define JOB_STATE_MAP(X) X(QUEUED, "queued") X(RUNNING, "running") X(SUCCEEDED, "succeeded") \
+	X(FAILED, "failed") X(CANCELLED, "cancelled")
+enum job_state {
+#define JOB_STATE_ENUM(c, n) JOB_##c,
+	JOB_STATE_MAP(JOB_STATE_ENUM)
+#undef JOB_STATE_ENUM
+	JOB_STATE_COUNT
+};
+const char *job_state_name(enum job_state st);
+int job_state_parse(const char *name, enum job_state *st);   /* 0, or -1 */
+/* Jobs per state, for /metrics. */
+enum api_code store_job_counts(struct store *s, long long counts[JOB_STATE_COUNT], struct api_error *err);
+
+/* ---- jobs, worker side (store_worker.c) ----
+ * A lease is (job, attempt) held by one worker token's user (who). Every worker write checks it
+ * in the writer thread: a job that is not running, or whose attempt is another, is
+ * API_STALE_ATTEMPT; a job leased by another worker user, or missing, is API_NOT_FOUND. */
+struct job_claim {
+	const struct principal *who;
+	const char *worker, *host;
+	long long claim_latency_ms;   /* out: submit (or requeue) to claim */
+};
+/* Leases the next job by fair share (docs/service.md §2); *job is NULL when none is claimable. */
+enum api_code store_claim(struct store *s, struct job_claim *in, json_t **job, struct api_error *err);
+/* Renews the lease of (id, attempt); progress (object or NULL) and solver_version (or NULL) are
+ * recorded. *cancel is 1 when a cancel was requested. */
+enum api_code store_heartbeat(struct store *s, const struct principal *who, long long id, int attempt,
+			      json_t *progress, const char *solver_version, int *cancel, long long *lease_expires_ms,
+			      struct api_error *err);
+/* Appends text at offset of (id, attempt)'s log; idempotent by offset; API_LOG_GAP. */
+enum api_code store_log_append(struct store *s, const struct principal *who, long long id, int attempt,
+			       long long offset, const char *text, size_t size, long long *next_offset,
+			       struct api_error *err);
+/* Log text of an attempt from offset (malloc'ed, *size bytes) and whether the attempt is still live.
+ * *attempt < 0 means the job's current attempt (written back). Visibility is the caller's check. */
+enum api_code store_log_read(struct store *s, long long id, int *attempt, long long offset, char **text,
+			     size_t *size, int *live, struct api_error *err);
+/* Read-only lease check before an upload starts; attempt < 0 accepts the current attempt. */
+enum api_code store_lease_check(struct store *s, const struct principal *who, long long id, int attempt,
+				int *current_attempt, struct api_error *err);
+/* Renames tmp_path to final_path and indexes the file, in one write, only if (id, attempt) still
+ * holds the lease; the rename happens in the writer so a stale attempt can never replace a file. */
+enum api_code store_file_commit(struct store *s, const struct principal *who, long long id, int attempt,
+				const char *name, long long size, const char *sha256, const char *tmp_path,
+				const char *final_path, struct api_error *err);
+/* The newest indexed version of a file of a job with attempt <= max_attempt (any when < 0). */
+enum api_code store_file_find(struct store *s, long long id, const char *name, int max_attempt, int *attempt,
+			      long long *size, char sha256[65], struct api_error *err);
+/* Ends (id, attempt) with outcome succeeded | failed | cancelled | infrastructure; exit_code < 0
+ * for none. *duration_ms gets claim-to-finish time. */
+enum api_code store_finish(struct store *s, const struct principal *who, long long id, int attempt,
+			   const char *worker, const char *outcome, const char *message, int exit_code,
+			   const char *solver_version, json_t **job, long long *duration_ms, struct api_error *err);
+
+/* Reaper (once a second): expired leases back to queued (or failed / cancelled), wall-time
+ * overruns failed. Counts what it did. */
+struct reap_counts { int expired, retried, lost, cancelled, overrun; };
+enum api_code store_reap(struct store *s, struct reap_counts *counts, struct api_error *err);
+
+/* Seconds of writer transactions, for the poro_commit_seconds histogram (set by the writer). */
+void store_set_commit_observer(struct store *s, void (*observe)(void *cls, double seconds), void *cls);
+
+#endif
