@@ -1,0 +1,261 @@
+/*
+ * poro_load.c - load generator for the job service (make bench, crash tests).
+ *
+ *   poro-load submit --server URL --token T --case FILE --clients C --count N [--key-prefix P]
+ *                    [--record FILE]
+ *       N POST /v1/jobs from C threads, each with its own keep-alive connection; submission i
+ *       carries Idempotency-Key P-i. Prints
+ *       "submissions: N ok, E errors, X.X per second; latency p50 A ms, p90 B ms, p99 C ms, max D ms".
+ *       --record writes one line per attempt, "key status job_id" (status 0 when no answer came,
+ *       job_id "-" when none), flushed as it goes, so a test that kills the server mid-run can
+ *       check that every acknowledged submission survived.
+ *   poro-load claim --server URL --token WORKER_TOKEN --count N --clients C
+ *       claims jobs and finishes each at once as "succeeded"; prints claims per second and claim
+ *       latency percentiles. A client stops when the queue stays empty for one short long-poll.
+ *
+ * Failures are counted, never fatal: the tool keeps going when the server disappears. Latency
+ * percentiles are over the requests that got an answer (nearest-rank).
+ */
+#define _GNU_SOURCE
+#include <errno.h>
+#include <math.h>
+#include <pthread.h>
+#include <signal.h>
+#include <stdatomic.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+#include <unistd.h>
+
+#include "http_client.h"
+#include "json_get.h"
+
+/* Long-poll of a load claim, seconds: short, so an empty queue ends the run quickly. */
+#define LOAD_CLAIM_WAIT 1
+
+struct load {
+	const char *server, *token, *case_file, *key_prefix, *record_path;
+	int clients;
+	long count;
+	int claim_mode;
+	json_t *body;            /* submission body (submit) */
+	atomic_long next;        /* next submission index / claims started */
+	atomic_long ok, errors, empty;
+	double *latency_ms;      /* count entries, NaN where no answer came */
+	FILE *record;
+	pthread_mutex_t record_lock;
+};
+
+static double now_s(void)
+{
+	struct timespec ts;
+	clock_gettime(CLOCK_MONOTONIC, &ts);
+	return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+static void record(struct load *l, const char *key, long status, long long id)
+{
+	if (!l->record)
+		return;
+	pthread_mutex_lock(&l->record_lock);
+	if (id >= 0)
+		fprintf(l->record, "%s %ld %lld\n", key, status, id);
+	else
+		fprintf(l->record, "%s %ld -\n", key, status);
+	fflush(l->record);
+	pthread_mutex_unlock(&l->record_lock);
+}
+
+static void *submit_client(void *arg)
+{
+	struct load *l = arg;
+	struct http_client *c = http_client_create(l->server, l->token);
+	if (!c)
+		return NULL;
+	for (;;) {
+		long i = atomic_fetch_add(&l->next, 1);
+		if (i >= l->count)
+			break;
+		char key[256], header[300];
+		snprintf(key, sizeof key, "%s-%ld", l->key_prefix, i);
+		snprintf(header, sizeof header, "Idempotency-Key: %s", key);
+		struct http_response r;
+		double t0 = now_s();
+		long status = http_json(c, "POST", "/v1/jobs", l->body, header, 60, &r);
+		double ms = 1e3 * (now_s() - t0);
+		l->latency_ms[i] = status ? ms : NAN;
+		long long id = status == 200 || status == 201 ? json_get_int(r.json, "id", -1) : -1;
+		if (id >= 0)
+			atomic_fetch_add(&l->ok, 1);
+		else
+			atomic_fetch_add(&l->errors, 1);
+		record(l, key, status, id);
+		http_response_release(&r);
+	}
+	http_client_destroy(&c);
+	return NULL;
+}
+
+static void *claim_client(void *arg)
+{
+	struct load *l = arg;
+	struct http_client *c = http_client_create(l->server, l->token);
+	if (!c)
+		return NULL;
+	char worker[128];
+	snprintf(worker, sizeof worker, "poro-load:%d:%lu", (int)getpid(), (unsigned long)pthread_self());
+	json_t *body = json_pack("{s:s, s:s, s:i, s:i}", "worker", worker, "host", "poro-load", "threads", 1,
+				 "wait_seconds", LOAD_CLAIM_WAIT);
+	for (;;) {
+		long i = atomic_fetch_add(&l->next, 1);
+		if (i >= l->count)
+			break;
+		struct http_response r;
+		double t0 = now_s();
+		long status = http_json(c, "POST", "/v1/worker/claim", body, NULL, LOAD_CLAIM_WAIT + 30, &r);
+		l->latency_ms[i] = status ? 1e3 * (now_s() - t0) : NAN;
+		json_t *job = json_object_get(r.json, "job");
+		if (status == 204) {
+			atomic_fetch_add(&l->empty, 1);
+			http_response_release(&r);
+			break;
+		}
+		if (status != 200 || !json_is_object(job)) {
+			atomic_fetch_add(&l->errors, 1);
+			http_response_release(&r);
+			continue;
+		}
+		char path[128];
+		snprintf(path, sizeof path, "/v1/worker/jobs/%lld/finish", json_get_int(job, "id", -1));
+		json_t *fin = json_pack("{s:I, s:s, s:n, s:i}", "attempt", (json_int_t)json_get_int(job, "attempt", 0),
+					"outcome", "succeeded", "message", "exit_code", 0);
+		struct http_response f;
+		http_json(c, "POST", path, fin, NULL, 30, &f);
+		json_decref(fin);
+		if (http_ok(&f))
+			atomic_fetch_add(&l->ok, 1);
+		else
+			atomic_fetch_add(&l->errors, 1);
+		http_response_release(&f);
+		http_response_release(&r);
+	}
+	json_decref(body);
+	http_client_destroy(&c);
+	return NULL;
+}
+
+static int cmp_double(const void *a, const void *b)
+{
+	double x = *(const double *)a, y = *(const double *)b;
+	return (x > y) - (x < y);
+}
+
+/* Nearest-rank percentile q of n sorted values. */
+static double percentile(const double *v, size_t n, double q)
+{
+	if (n == 0)
+		return 0;
+	size_t k = (size_t)ceil(q * (double)n);
+	return v[k > 0 ? k - 1 : 0];
+}
+
+static int usage(void)
+{
+	fprintf(stderr, "usage: poro-load submit --server URL --token T --case FILE --clients C --count N\n"
+			"                        [--key-prefix P] [--record FILE]\n"
+			"       poro-load claim --server URL --token WORKER_TOKEN --count N --clients C\n");
+	return 2;
+}
+
+static int parse_args(struct load *l, int argc, char **argv)
+{
+	if (argc < 2)
+		return -1;
+	if (!strcmp(argv[1], "claim"))
+		l->claim_mode = 1;
+	else if (strcmp(argv[1], "submit"))
+		return -1;
+	for (int i = 2; i + 1 < argc; i += 2) {
+		const char *a = argv[i], *v = argv[i + 1];
+		if (!strcmp(a, "--server"))
+			l->server = v;
+		else if (!strcmp(a, "--token"))
+			l->token = v;
+		else if (!strcmp(a, "--case"))
+			l->case_file = v;
+		else if (!strcmp(a, "--key-prefix"))
+			l->key_prefix = v;
+		else if (!strcmp(a, "--record"))
+			l->record_path = v;
+		else if (!strcmp(a, "--clients"))
+			l->clients = atoi(v);
+		else if (!strcmp(a, "--count"))
+			l->count = atol(v);
+		else
+			return -1;
+	}
+	if ((argc - 2) % 2 || !l->server || !l->token || l->clients < 1 || l->count < 1)
+		return -1;
+	return l->claim_mode || l->case_file ? 0 : -1;
+}
+
+int main(int argc, char **argv)
+{
+	static struct load l;
+	l.key_prefix = "load";
+	if (parse_args(&l, argc, argv) < 0)
+		return usage();
+	if (!l.claim_mode) {
+		json_error_t jerr;
+		json_t *spec = json_load_file(l.case_file, 0, &jerr);
+		if (!spec) {
+			fprintf(stderr, "poro-load: cannot read '%s': %s (line %d)\n", l.case_file, jerr.text, jerr.line);
+			return 1;
+		}
+		l.body = json_pack("{s:o}", "case", spec);
+	}
+	if (l.record_path && !(l.record = fopen(l.record_path, "w"))) {
+		fprintf(stderr, "poro-load: cannot create '%s': %s\n", l.record_path, strerror(errno));
+		return 1;
+	}
+	l.latency_ms = malloc((size_t)l.count * sizeof *l.latency_ms);
+	pthread_t *threads = calloc((size_t)l.clients, sizeof *threads);
+	if (!l.latency_ms || !threads || http_global_init() < 0) {
+		fprintf(stderr, "poro-load: out of memory\n");
+		return 1;
+	}
+	for (long i = 0; i < l.count; i++)
+		l.latency_ms[i] = NAN;
+	pthread_mutex_init(&l.record_lock, NULL);
+	signal(SIGPIPE, SIG_IGN);
+	double t0 = now_s();
+	int started = 0;
+	for (int i = 0; i < l.clients; i++)
+		if (!pthread_create(&threads[started], NULL, l.claim_mode ? claim_client : submit_client, &l))
+			started++;
+	for (int i = 0; i < started; i++)
+		pthread_join(threads[i], NULL);
+	double elapsed = now_s() - t0;
+	size_t n = 0;
+	for (long i = 0; i < l.count; i++)
+		if (!isnan(l.latency_ms[i]))
+			l.latency_ms[n++] = l.latency_ms[i];
+	qsort(l.latency_ms, n, sizeof *l.latency_ms, cmp_double);
+	long ok = atomic_load(&l.ok), errors = atomic_load(&l.errors);
+	if (l.claim_mode)
+		printf("claims: %ld ok, %ld errors, %ld empty, %.1f per second; ", ok, errors, atomic_load(&l.empty),
+		       elapsed > 0 ? (double)ok / elapsed : 0.0);
+	else
+		printf("submissions: %ld ok, %ld errors, %.1f per second; ", ok, errors,
+		       elapsed > 0 ? (double)ok / elapsed : 0.0);
+	printf("latency p50 %.1f ms, p90 %.1f ms, p99 %.1f ms, max %.1f ms\n", percentile(l.latency_ms, n, 0.5),
+	       percentile(l.latency_ms, n, 0.9), percentile(l.latency_ms, n, 0.99), n ? l.latency_ms[n - 1] : 0.0);
+	if (l.record)
+		fclose(l.record);
+	json_decref(l.body);
+	free(l.latency_ms);
+	free(threads);
+	http_global_cleanup();
+	return 0;
+}

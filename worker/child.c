@@ -1,0 +1,117 @@
+/*
+ * child.c - fork/exec of the solver with its limits, see child.h. The pipe is created with
+ * O_CLOEXEC so that a solver started by another slot never inherits this one's write end (which
+ * would keep this job's pipe open after its solver has exited).
+ */
+#define _GNU_SOURCE
+#include "child.h"
+
+#include <errno.h>
+#include <fcntl.h>
+#include <signal.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/resource.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+extern char **environ;
+
+/* environ without OMP_NUM_THREADS, plus OMP_NUM_THREADS=threads; NULL when out of memory. The
+ * strings are environ's own except the last, which is env_omp. */
+static char **child_environment(int threads, char *env_omp, size_t size)
+{
+	size_t n = 0;
+	while (environ[n])
+		n++;
+	char **env = calloc(n + 2, sizeof *env);
+	if (!env)
+		return NULL;
+	size_t k = 0;
+	for (size_t i = 0; i < n; i++)
+		if (strncmp(environ[i], "OMP_NUM_THREADS=", 16))
+			env[k++] = environ[i];
+	snprintf(env_omp, size, "OMP_NUM_THREADS=%d", threads > 0 ? threads : 1);
+	env[k++] = env_omp;
+	env[k] = NULL;
+	return env;
+}
+
+int child_start(const struct child_spec *spec, pid_t *pid, int *out_fd, char *err, size_t err_size)
+{
+	int fds[2];
+	char omp[64];
+	static const char exec_failed[] = "poro-worker: cannot execute the solver\n";
+	if (pipe2(fds, O_CLOEXEC) < 0) {
+		snprintf(err, err_size, "cannot create a pipe: %s", strerror(errno));
+		return -1;
+	}
+	char **env = child_environment(spec->threads, omp, sizeof omp);
+	if (!env) {
+		close(fds[0]);
+		close(fds[1]);
+		snprintf(err, err_size, "out of memory");
+		return -1;
+	}
+	struct rlimit as = {RLIM_INFINITY, RLIM_INFINITY};
+	if (spec->memory_limit_mb > 0)
+		as.rlim_cur = as.rlim_max = (rlim_t)spec->memory_limit_mb << 20;
+	pid_t p = fork();
+	if (p < 0) {
+		snprintf(err, err_size, "cannot fork: %s", strerror(errno));
+		close(fds[0]);
+		close(fds[1]);
+		free(env);
+		return -1;
+	}
+	if (p == 0) {
+		sigset_t none;
+		sigemptyset(&none);
+		sigprocmask(SIG_SETMASK, &none, NULL);
+		signal(SIGPIPE, SIG_DFL);
+		setpgid(0, 0);
+		int in = open("/dev/null", O_RDONLY);
+		if (in >= 0)
+			dup2(in, 0);
+		dup2(fds[1], 1);
+		dup2(fds[1], 2);
+		if (spec->memory_limit_mb > 0)
+			setrlimit(RLIMIT_AS, &as);
+		if (chdir(spec->dir) == 0)
+			execve(spec->argv[0], spec->argv, env);
+		ssize_t w = write(2, exec_failed, sizeof exec_failed - 1);
+		(void)w;
+		_exit(CHILD_EXEC_FAILED);
+	}
+	/* Also in the parent, so that a signal sent right after fork reaches the group. */
+	setpgid(p, p);
+	close(fds[1]);
+	free(env);
+	*pid = p;
+	*out_fd = fds[0];
+	return 0;
+}
+
+void child_signal(pid_t pid, int sig)
+{
+	if (pid > 0)
+		kill(-pid, sig);
+}
+
+int child_reap(pid_t pid, int *status)
+{
+	for (;;) {
+		pid_t r = waitpid(pid, status, WNOHANG);
+		if (r == pid)
+			return 1;
+		if (r < 0 && errno == EINTR)
+			continue;
+		if (r < 0) {
+			/* not our child any more (already reaped): report it as killed */
+			*status = SIGKILL;
+			return 1;
+		}
+		return 0;
+	}
+}

@@ -1,0 +1,531 @@
+/*
+ * job.c - one running job, see job.h. The job's thread supervises in a poll loop every
+ * JOB_TICK seconds while the solver's output is read on the log pump's thread; so the solver keeps
+ * running while a call to the server waits or fails. Each kind of write (log, heartbeat,
+ * checkpoint upload) has its own backoff, so one failing call type neither blocks the others nor
+ * hammers the server. Outcomes (docs/service.md §2):
+ *   exit 0 -> succeeded; exit 2 or 3 (invalid input, solver failure) -> failed with the solver's
+ *   error message; exit 6 or a signal after a cancel -> cancelled; wall time exceeded -> failed;
+ *   exit 4 or 5, a signal the worker did not send, a failure to start, a second SIGTERM to the
+ *   worker -> infrastructure (the server re-queues the job and it resumes from its checkpoint).
+ */
+#define _GNU_SOURCE
+#include "job.h"
+
+#include <errno.h>
+#include <signal.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include "backoff.h"
+#include "child.h"
+#include "job_files.h"
+#include "json_get.h"
+#include "log_pump.h"
+#include "worker.h"
+
+/* Supervision period, seconds. */
+#define JOB_TICK 0.05
+/* Attempts at downloading a checkpoint before the job is handed back as infrastructure. */
+#define JOB_FETCH_TRIES 5
+
+enum stop_reason { STOP_NONE, STOP_CANCEL, STOP_WALL, STOP_SHUTDOWN, STOP_LOST };
+enum send_result { SEND_OK, SEND_RETRY, SEND_REFUSED, SEND_LOST };
+
+/* A result file staged for upload: a snapshot path and its checksum. */
+struct staged {
+	int pending;
+	char path[4400];
+	char sha256[DIGEST_HEX_SIZE];
+};
+
+struct job {
+	long long id;
+	int attempt;
+	int threads;
+	long wall_time;          /* seconds, 0: no limit */
+	double heartbeat_every;  /* seconds */
+	char tag[64];            /* "job 12 attempt 1" for messages */
+	char dir[4200];          /* WORK/job-<id>-<attempt> */
+	struct http_client *http;
+
+	pid_t pid;
+	int running;             /* the child has not been reaped */
+	int wait_status;
+	double started, exited_at, term_at;
+	int term_sent, kill_sent;
+	enum stop_reason stop;
+
+	struct log_pump pump;
+	char *chunk;             /* WORKER_LOG_CHUNK bytes for log sends */
+	int log_broken;          /* the server lost log text we no longer hold: stop sending */
+	double last_log_at;
+	struct backoff log_b, hb_b, up_b;
+	double next_heartbeat_at;
+	int checkpoints_seen;
+	struct staged up_result, up_checkpoint; /* result.h5 goes first, so it is never older */
+};
+
+static void say_job(const struct job *j, const char *what, const struct http_response *r)
+{
+	char why[700];
+	worker_say("%s: %s: %s", j->tag, what, http_describe(r, why, sizeof why));
+}
+
+/* Sorts an answer into ok / retry later / refused / lease lost, and says what happened. */
+static enum send_result classify(struct job *j, const char *what, const struct http_response *r,
+				 struct backoff *b)
+{
+	char why[700];
+	if (http_ok(r)) {
+		backoff_reset(b);
+		return SEND_OK;
+	}
+	if (r->status == 404 || (r->status == 409 && strcmp(r->code, "log_gap"))) {
+		worker_say("%s: %s refused, the lease is gone: %s", j->tag, what, http_describe(r, why, sizeof why));
+		j->stop = STOP_LOST;
+		return SEND_LOST;
+	}
+	double wait = backoff_fail(b, worker_now());
+	if (http_transient(r)) {
+		worker_say("%s: %s failed, retrying in %.1f s: %s", j->tag, what, wait,
+			   http_describe(r, why, sizeof why));
+		return SEND_RETRY;
+	}
+	say_job(j, what, r);
+	return SEND_REFUSED;
+}
+
+static void terminate(struct job *j, double now)
+{
+	if (j->term_sent || !j->running)
+		return;
+	child_signal(j->pid, SIGTERM);
+	j->term_sent = 1;
+	j->term_at = now;
+}
+
+static enum send_result send_log(struct job *j)
+{
+	long long offset;
+	size_t n = log_pump_peek(&j->pump, j->chunk, WORKER_LOG_CHUNK, &offset);
+	if (n == 0 || j->log_broken)
+		return SEND_OK;
+	json_t *body = json_pack("{s:i, s:I, s:s%}", "attempt", j->attempt, "offset", (json_int_t)offset, "text",
+				 j->chunk, n);
+	char path[128];
+	snprintf(path, sizeof path, "/v1/worker/jobs/%lld/log", j->id);
+	struct http_response r;
+	http_json(j->http, "POST", path, body, NULL, 30, &r);
+	json_decref(body);
+	enum send_result s = classify(j, "log chunk", &r, &j->log_b);
+	if (s == SEND_OK) {
+		log_pump_ack(&j->pump, offset + (long long)n);
+	} else if (r.status == 409) {
+		/* log_gap: the server expects another offset; accept it if we sent past it */
+		json_t *e = json_object_get(r.json, "error");
+		long long want = json_get_int(r.json, "expected_offset",
+					      json_get_int(e, "expected_offset", json_get_int(r.json, "next_offset", -1)));
+		if (want > offset) {
+			log_pump_ack(&j->pump, want);
+			backoff_reset(&j->log_b);
+		} else {
+			worker_say("%s: the server lost log text before offset %lld; no more log is sent", j->tag, offset);
+			j->log_broken = 1;
+		}
+	}
+	http_response_release(&r);
+	return s;
+}
+
+static enum send_result send_heartbeat(struct job *j)
+{
+	struct log_progress g = log_pump_progress(&j->pump);
+	json_t *progress = json_null();
+	if (g.valid)
+		progress = json_pack("{s:I, s:f, s:f, s:f}", "step", (json_int_t)g.step, "time", g.time,
+				     "us_per_mp_step", g.us_per_mp_step, "fraction",
+				     g.steps_total > 0 ? (double)g.step / (double)g.steps_total : 0.0);
+	json_t *body = json_pack("{s:i, s:o, s:s}", "attempt", j->attempt, "progress", progress, "solver_version",
+				 worker_opt.solver_version);
+	char path[128];
+	snprintf(path, sizeof path, "/v1/worker/jobs/%lld/heartbeat", j->id);
+	struct http_response r;
+	http_json(j->http, "POST", path, body, NULL, 30, &r);
+	json_decref(body);
+	enum send_result s = classify(j, "heartbeat", &r, &j->hb_b);
+	if (s == SEND_OK && json_get_bool(r.json, "cancel", 0) && j->stop == STOP_NONE && j->running) {
+		worker_say("%s: cancel requested, stopping the solver", j->tag);
+		j->stop = STOP_CANCEL;
+		terminate(j, worker_now());
+	}
+	http_response_release(&r);
+	return s;
+}
+
+/* Uploads one file; a refusal other than a lost lease drops the file (it is not retried). */
+static enum send_result upload(struct job *j, const char *name, struct staged *f)
+{
+	struct http_response r;
+	char what[160];
+	snprintf(what, sizeof what, "upload of '%s'", name);
+	job_files_upload(j->http, j->id, j->attempt, name, f->path, f->sha256, &r);
+	enum send_result s = classify(j, what, &r, &j->up_b);
+	if (s == SEND_OK || s == SEND_REFUSED)
+		f->pending = 0;
+	http_response_release(&r);
+	return s;
+}
+
+/* Stages src of the output directory as a snapshot in upload/ for name; 0 when the file exists. */
+static int stage(struct job *j, const char *name, struct staged *f, int snapshot)
+{
+	char src[4400];
+	snprintf(src, sizeof src, "%s/out/%s", j->dir, name);
+	if (!snapshot) {
+		snprintf(f->path, sizeof f->path, "%s", src);
+		if (digest_file_hex(src, f->sha256, NULL) < 0)
+			return -1;
+	} else {
+		snprintf(f->path, sizeof f->path, "%s/upload/%s", j->dir, name);
+		if (job_files_snapshot(src, f->path, f->sha256) < 0) {
+			if (errno != ENOENT)
+				worker_say("%s: cannot copy '%s' for upload: %s", j->tag, name, strerror(errno));
+			return -1;
+		}
+	}
+	f->pending = 1;
+	return 0;
+}
+
+/* After a "checkpoint" line: snapshot checkpoint.h5 and result.h5, then upload them in turn. */
+static void checkpoint_uploads(struct job *j, double now)
+{
+	int seen = log_pump_checkpoints(&j->pump);
+	if (seen > j->checkpoints_seen) {
+		j->checkpoints_seen = seen;
+		if (stage(j, "checkpoint.h5", &j->up_checkpoint, 1) == 0) {
+			stage(j, "result.h5", &j->up_result, 1);
+			backoff_reset(&j->up_b);
+		}
+	}
+	if (!backoff_due(&j->up_b, now))
+		return;
+	if (j->up_result.pending && upload(j, "result.h5", &j->up_result) != SEND_OK)
+		return;
+	if (j->up_checkpoint.pending && upload(j, "checkpoint.h5", &j->up_checkpoint) == SEND_OK)
+		worker_say("%s: checkpoint uploaded", j->tag);
+}
+
+static void heartbeat_if_due(struct job *j, double now)
+{
+	if (now >= j->next_heartbeat_at && backoff_due(&j->hb_b, now)) {
+		if (send_heartbeat(j) != SEND_RETRY)
+			j->next_heartbeat_at = now + j->heartbeat_every;
+	}
+}
+
+/* Runs until the solver is reaped and its output drained, or the lease is lost. */
+static void supervise(struct job *j)
+{
+	for (;;) {
+		double now = worker_now();
+		if (j->stop == STOP_LOST)
+			return;
+		if (j->running && atomic_load(&worker_stopping) && j->stop == STOP_NONE) {
+			worker_say("%s: worker stopping, terminating the solver", j->tag);
+			j->stop = STOP_SHUTDOWN;
+			terminate(j, now);
+		}
+		if (j->running && j->wall_time > 0 && now - j->started >= (double)j->wall_time && j->stop == STOP_NONE) {
+			worker_say("%s: wall time of %ld s reached, terminating the solver", j->tag, j->wall_time);
+			j->stop = STOP_WALL;
+			terminate(j, now);
+		}
+		if (j->term_sent && !j->kill_sent && now - j->term_at >= WORKER_KILL_GRACE) {
+			child_signal(j->pid, SIGKILL);
+			j->kill_sent = 1;
+		}
+		if (j->running && child_reap(j->pid, &j->wait_status)) {
+			j->running = 0;
+			j->exited_at = now;
+		}
+		int eof;
+		long long unsent = log_pump_unsent(&j->pump, &eof);
+		if (!j->running && eof)
+			return;
+		if (!j->running && now - j->exited_at > WORKER_KILL_GRACE) {
+			/* something the solver started still holds the pipe: end its group */
+			child_signal(j->pid, SIGKILL);
+		}
+		if (unsent > 0 && now - j->last_log_at >= WORKER_LOG_INTERVAL && backoff_due(&j->log_b, now)) {
+			j->last_log_at = now;
+			send_log(j);
+		}
+		if (j->stop != STOP_LOST)
+			heartbeat_if_due(j, now);
+		if (j->stop != STOP_LOST)
+			checkpoint_uploads(j, now);
+		usleep((useconds_t)(JOB_TICK * 1e6));
+	}
+}
+
+/* Decides the outcome from the wait status and why the worker stopped the solver. */
+static const char *outcome(struct job *j, char *message, size_t size, int *exit_code)
+{
+	char err[LOG_PUMP_ERROR_MAX + 1];
+	log_pump_error(&j->pump, err, sizeof err);
+	int st = j->wait_status;
+	int exited = WIFEXITED(st), code = exited ? WEXITSTATUS(st) : 0, sig = exited ? 0 : WTERMSIG(st);
+	*exit_code = exited ? code : 128 + sig;
+	if (exited && code == 0) {
+		snprintf(message, size, "%s", "");
+		return "succeeded";
+	}
+	switch (j->stop) {
+	case STOP_CANCEL:
+		snprintf(message, size, "cancelled on request");
+		return "cancelled";
+	case STOP_WALL:
+		snprintf(message, size, "wall time limit of %ld s exceeded", j->wall_time);
+		return "failed";
+	case STOP_SHUTDOWN:
+		snprintf(message, size, "worker '%s' was stopped while the job ran", worker_opt.name);
+		return "infrastructure";
+	default:
+		break;
+	}
+	if (!exited) {
+		snprintf(message, size, "solver killed by signal %d (%s)%s%s", sig, strsignal(sig), err[0] ? ": " : "",
+			 err);
+		return "infrastructure";
+	}
+	if (code == CHILD_EXEC_FAILED) {
+		snprintf(message, size, "cannot start the solver '%s'", worker_opt.solver);
+		return "infrastructure";
+	}
+	if (err[0])
+		snprintf(message, size, "%s", err);
+	else
+		snprintf(message, size, "solver exited with status %d", code);
+	if (code == 4 || code == 5 || code == 6)
+		return "infrastructure";
+	return "failed";
+}
+
+/* Deadline for the work after the solver ended: shorter once the worker is told to stop. */
+static int before_deadline(double deadline)
+{
+	double now = worker_now();
+	static _Thread_local double stop_seen;
+	if (atomic_load(&worker_stopping)) {
+		if (stop_seen == 0)
+			stop_seen = now;
+		if (now > stop_seen + WORKER_STOP_PATIENCE)
+			return 0;
+	}
+	return now < deadline;
+}
+
+/* Waits out the backoff b while keeping the lease renewed; 0 when the job must give up. */
+static int wait_retry(struct job *j, struct backoff *b, double deadline)
+{
+	while (!backoff_due(b, worker_now())) {
+		if (!before_deadline(deadline) || j->stop == STOP_LOST)
+			return 0;
+		heartbeat_if_due(j, worker_now());
+		usleep(50000);
+	}
+	return before_deadline(deadline) && j->stop != STOP_LOST;
+}
+
+static void flush_log(struct job *j, double deadline)
+{
+	while (!j->log_broken && log_pump_unsent(&j->pump, NULL) > 0 && wait_retry(j, &j->log_b, deadline))
+		send_log(j);
+}
+
+static void final_uploads(struct job *j, double deadline)
+{
+	static const char *names[] = {"result.h5", "result.xdmf", "checkpoint.h5"};
+	/* a checkpoint announced but not yet sent goes first, as during the run */
+	while ((j->up_result.pending || j->up_checkpoint.pending) && wait_retry(j, &j->up_b, deadline))
+		checkpoint_uploads(j, worker_now());
+	for (size_t i = 0; i < sizeof names / sizeof *names; i++) {
+		struct staged f = {0};
+		if (stage(j, names[i], &f, 0) < 0)
+			continue;
+		while (f.pending && wait_retry(j, &j->up_b, deadline))
+			upload(j, names[i], &f);
+	}
+}
+
+static void finish(struct job *j, const char *result, const char *message, int exit_code, double deadline)
+{
+	/* an empty message is sent as null: the server takes strings of 1 byte or more */
+	json_t *body = json_pack("{s:i, s:s, s:o, s:i, s:s}", "attempt", j->attempt, "outcome", result, "message",
+				 message[0] ? json_string(message) : json_null(), "exit_code", exit_code, "solver_version",
+				 worker_opt.solver_version);
+	char path[128];
+	snprintf(path, sizeof path, "/v1/worker/jobs/%lld/finish", j->id);
+	struct backoff b = {0};
+	int done = 0;
+	while (!done && wait_retry(j, &b, deadline)) {
+		struct http_response r;
+		http_json(j->http, "POST", path, body, NULL, 30, &r);
+		enum send_result s = classify(j, "finish", &r, &b);
+		http_response_release(&r);
+		if (s == SEND_OK)
+			worker_say("%s: finished %s%s%s", j->tag, result, message[0] ? ": " : "", message);
+		done = s != SEND_RETRY;
+	}
+	if (!done && j->stop != STOP_LOST)
+		worker_say("%s: gave up reporting '%s'; the lease will expire", j->tag, result);
+	json_decref(body);
+}
+
+/* Fills j from the claim and creates the job directory with case.json. 0, or -1 with err. */
+static int prepare(struct job *j, const json_t *claim, char *err, size_t err_size)
+{
+	j->id = json_get_int(claim, "id", -1);
+	j->attempt = (int)json_get_int(claim, "attempt", 0);
+	j->threads = (int)json_get_int(claim, "threads", 1);
+	j->wall_time = (long)json_get_int(claim, "wall_time_seconds", 0);
+	double lease = json_get_real(claim, "lease_seconds", 30);
+	j->heartbeat_every = worker_opt.lease_renew > 0 ? worker_opt.lease_renew : lease / 3;
+	if (j->heartbeat_every > WORKER_HEARTBEAT_MAX && worker_opt.lease_renew <= 0)
+		j->heartbeat_every = WORKER_HEARTBEAT_MAX;
+	if (j->heartbeat_every < 0.2)
+		j->heartbeat_every = 0.2;
+	snprintf(j->tag, sizeof j->tag, "job %lld attempt %d", j->id, j->attempt);
+	snprintf(j->dir, sizeof j->dir, "%s/job-%lld-%d", worker_opt.work, j->id, j->attempt);
+	json_t *c = json_object_get(claim, "case");
+	if (j->id < 0 || !json_is_object(c)) {
+		snprintf(err, err_size, "claim answer without a job id or case");
+		return -1;
+	}
+	job_files_remove_tree(j->dir);
+	char sub[4400];
+	if (mkdir(j->dir, 0755) < 0) {
+		snprintf(err, err_size, "cannot create '%s': %s", j->dir, strerror(errno));
+		return -1;
+	}
+	snprintf(sub, sizeof sub, "%s/out", j->dir);
+	mkdir(sub, 0755);
+	snprintf(sub, sizeof sub, "%s/upload", j->dir);
+	mkdir(sub, 0755);
+	snprintf(sub, sizeof sub, "%s/case.json", j->dir);
+	if (json_dump_file(c, sub, JSON_INDENT(1)) < 0) {
+		snprintf(err, err_size, "cannot write '%s'", sub);
+		return -1;
+	}
+	return 0;
+}
+
+/* Downloads the checkpoint of an earlier attempt; 0, or -1 with err. */
+static int fetch_checkpoint(struct job *j, const json_t *checkpoint, char *err, size_t err_size)
+{
+	char out[4400];
+	snprintf(out, sizeof out, "%s/out", j->dir);
+	const char *sha = json_get_str(checkpoint, "sha256", "");
+	struct backoff b = {0};
+	for (int i = 0; i < JOB_FETCH_TRIES && !atomic_load(&worker_stopping); i++) {
+		int rc = job_files_fetch_resume(j->http, j->id, j->attempt, out, sha, err, err_size);
+		if (rc <= 0)
+			return rc;
+		double wait = backoff_fail(&b, worker_now());
+		worker_say("%s: %s, retrying in %.1f s", j->tag, err, wait);
+		worker_sleep(wait, 0);
+	}
+	return -1;
+}
+
+/* Starts the solver; 0, or -1 with err. */
+static int start_solver(struct job *j, int resume, char *err, size_t err_size)
+{
+	char wall[32];
+	char *argv[12];
+	int n = 0;
+	argv[n++] = worker_opt.solver;
+	argv[n++] = "run";
+	argv[n++] = "case.json";
+	argv[n++] = "--out";
+	argv[n++] = "out";
+	if (resume) {
+		argv[n++] = "--resume";
+		argv[n++] = "out/checkpoint.h5";
+	}
+	if (worker_opt.checkpoint_flag && worker_opt.checkpoint_wall > 0) {
+		snprintf(wall, sizeof wall, "%ld", worker_opt.checkpoint_wall);
+		argv[n++] = (char *)worker_opt.checkpoint_flag;
+		argv[n++] = wall;
+	}
+	argv[n] = NULL;
+	struct child_spec spec = {j->dir, argv, worker_opt.memory_limit_mb, j->threads};
+	int fd;
+	if (child_start(&spec, &j->pid, &fd, err, err_size) < 0)
+		return -1;
+	j->running = 1;
+	j->started = worker_now();
+	char log_path[4400];
+	snprintf(log_path, sizeof log_path, "%s/log.txt", j->dir);
+	if (log_pump_start(&j->pump, fd, log_path) < 0) {
+		/* cannot read its output: end it, the job goes back to the queue */
+		snprintf(err, err_size, "cannot start the log thread: %s", strerror(errno));
+		child_signal(j->pid, SIGKILL);
+		waitpid(j->pid, &j->wait_status, 0);
+		close(fd);
+		j->running = 0;
+		return -1;
+	}
+	worker_say("%s: solver started (pid %d%s)", j->tag, (int)j->pid, resume ? ", resuming from the checkpoint" : "");
+	return 0;
+}
+
+void job_run(struct http_client *c, const json_t *claim)
+{
+	struct job j = {0};
+	char err[10000];
+	j.http = c;
+	j.chunk = malloc(WORKER_LOG_CHUNK);
+	int prepared = prepare(&j, claim, err, sizeof err) == 0 && j.chunk;
+	const json_t *checkpoint = json_object_get(claim, "checkpoint");
+	int resume = json_is_object(checkpoint);
+	worker_say("%s: claimed (%d thread%s, wall time %ld s%s)", j.tag, j.threads, j.threads == 1 ? "" : "s",
+		   j.wall_time, resume ? ", from a checkpoint" : "");
+	int started = 0;
+	if (prepared && resume && fetch_checkpoint(&j, checkpoint, err, sizeof err) < 0)
+		prepared = 0;
+	if (prepared && start_solver(&j, resume, err, sizeof err) == 0)
+		started = 1;
+	double deadline;
+	if (!started) {
+		worker_say("%s: cannot run: %s", j.tag, err);
+		if (j.id >= 0)
+			finish(&j, "infrastructure", err, -1, worker_now() + WORKER_FINISH_PATIENCE);
+	} else {
+		supervise(&j);
+		if (j.stop == STOP_LOST) {
+			child_signal(j.pid, SIGKILL);
+			if (j.running)
+				waitpid(j.pid, &j.wait_status, 0);
+		} else {
+			char message[8192];
+			int exit_code;
+			const char *result = outcome(&j, message, sizeof message, &exit_code);
+			deadline = worker_now() + WORKER_FINISH_PATIENCE;
+			flush_log(&j, deadline);
+			if (strcmp(result, "infrastructure") || !atomic_load(&worker_stopping))
+				final_uploads(&j, deadline);
+			if (j.stop != STOP_LOST)
+				finish(&j, result, message, exit_code, deadline);
+		}
+		log_pump_release(&j.pump);
+	}
+	free(j.chunk);
+	job_files_remove_tree(j.dir);
+}

@@ -1,0 +1,20 @@
+/*
+ * job.h - one claimed job from start to finish: the job directory WORK/job-<id>-<attempt>/, the
+ * checkpoint download when the claim carries one, the solver child, the log chunks, heartbeats
+ * with progress, checkpoint uploads, cancel and wall-time enforcement, the final uploads and the
+ * finish call (docs/service.md §2, §3 "Workers"). A write refused as stale (409) or for a job
+ * that is gone (404) means the lease is lost: the solver's group is killed at once, the directory
+ * removed, and nothing more is sent.
+ */
+#ifndef PORO_JOB_H
+#define PORO_JOB_H
+
+#include <jansson.h>
+
+#include "http_client.h"
+
+/* Runs the job of a claim answer ({"id", "attempt", "case", ...}) to its end with c, which must not
+ * abort on drain. Returns when the job is finished or abandoned and its directory is removed. */
+void job_run(struct http_client *c, const json_t *claim);
+
+#endif

@@ -1,0 +1,306 @@
+/*
+ * main.c - poro-worker's command line, signals and slot threads.
+ *
+ *   poro-worker --server URL --token TOKEN [--slots N (1)] [--work DIR (./var/work)]
+ *               [--solver PATH] [--memory-limit-mb N] [--checkpoint-wall SECONDS (60)]
+ *               [--lease-renew SECONDS] [--name NAME]
+ *
+ * The token may come from PORO_TOKEN and the URL from PORO_SERVER (or the config file read by the
+ * CLI). The solver defaults to poro-solve next to this binary, else the first on PATH. SIGTERM or
+ * SIGINT drains: no new claims, running jobs finish, exit 0. A second one stops the solvers (their
+ * jobs are reported as infrastructure failures and re-queued) and the worker exits. The signals
+ * are blocked in every thread and taken synchronously here with sigtimedwait, so no handler runs
+ * inside library code. Exit status: 0 after a drain, 1 when the server refused the token, 2 for a
+ * bad command line.
+ */
+#define _GNU_SOURCE
+#include <errno.h>
+#include <limits.h>
+#include <pthread.h>
+#include <signal.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <time.h>
+#include <unistd.h>
+
+#include "client_config.h"
+#include "http_client.h"
+#include "worker.h"
+
+struct worker_options worker_opt;
+atomic_int worker_draining;
+atomic_int worker_stopping;
+atomic_int worker_fatal;
+static atomic_int slots_running;
+static pthread_mutex_t say_lock = PTHREAD_MUTEX_INITIALIZER;
+
+void worker_say(const char *fmt, ...)
+{
+	char stamp[32];
+	struct timespec ts;
+	struct tm tm;
+	clock_gettime(CLOCK_REALTIME, &ts);
+	gmtime_r(&ts.tv_sec, &tm);
+	strftime(stamp, sizeof stamp, "%Y-%m-%dT%H:%M:%S", &tm);
+	va_list ap;
+	va_start(ap, fmt);
+	pthread_mutex_lock(&say_lock);
+	printf("%s.%03ldZ poro-worker: ", stamp, ts.tv_nsec / 1000000);
+	vprintf(fmt, ap);
+	putchar('\n');
+	fflush(stdout);
+	pthread_mutex_unlock(&say_lock);
+	va_end(ap);
+}
+
+double worker_now(void)
+{
+	struct timespec ts;
+	clock_gettime(CLOCK_MONOTONIC, &ts);
+	return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+void worker_sleep(double seconds, int wake_on_drain)
+{
+	double end = worker_now() + seconds;
+	while (worker_now() < end && !atomic_load(&worker_stopping) && !(wake_on_drain && atomic_load(&worker_draining)))
+		usleep(20000);
+}
+
+static int usage(void)
+{
+	fprintf(stderr, "usage: poro-worker --server URL --token TOKEN [--slots N] [--work DIR] [--solver PATH]\n"
+			"                   [--memory-limit-mb N] [--checkpoint-wall SECONDS] [--lease-renew SECONDS]\n"
+			"                   [--name NAME]\n");
+	return 2;
+}
+
+static int parse_long(const char *s, long lo, long hi, long *out)
+{
+	char *end;
+	errno = 0;
+	long v = strtol(s, &end, 10);
+	if (errno || *end || end == s || v < lo || v > hi)
+		return -1;
+	*out = v;
+	return 0;
+}
+
+/* An absolute version of path (which need not exist yet). */
+static void absolute(const char *path, char *out, size_t size)
+{
+	char cwd[PATH_MAX];
+	if (path[0] == '/' || !getcwd(cwd, sizeof cwd))
+		snprintf(out, size, "%s", path);
+	else
+		if (snprintf(out, size, "%s/%s", cwd, path) >= (int)size)
+			snprintf(out, size, "%s", path);
+}
+
+/* --solver, else poro-solve next to this binary, else the first poro-solve on PATH. */
+static int find_solver(const char *given, char *out, size_t size)
+{
+	if (given) {
+		absolute(given, out, size);
+		return access(out, X_OK);
+	}
+	char self[PATH_MAX];
+	ssize_t n = readlink("/proc/self/exe", self, sizeof self - 1);
+	if (n > 0) {
+		self[n] = '\0';
+		char *slash = strrchr(self, '/');
+		if (slash) {
+			*slash = '\0';
+			if (snprintf(out, size, "%s/poro-solve", self) < (int)size && access(out, X_OK) == 0)
+				return 0;
+		}
+	}
+	const char *path = getenv("PATH");
+	char *copy = strdup(path ? path : "/usr/local/bin:/usr/bin:/bin");
+	int rc = -1;
+	for (char *save = NULL, *dir = strtok_r(copy, ":", &save); dir && rc; dir = strtok_r(NULL, ":", &save)) {
+		if (snprintf(out, size, "%s/poro-solve", *dir ? dir : ".") < (int)size && access(out, X_OK) == 0) {
+			char tmp[PATH_MAX];
+			absolute(out, tmp, sizeof tmp);
+			snprintf(out, size, "%s", tmp);
+			rc = 0;
+		}
+	}
+	free(copy);
+	return rc;
+}
+
+/* Asks the solver its version, and which option (if any) takes a wall-time checkpoint interval:
+ * its usage text names it. The current poro-solve knows "--checkpoint-wall"; "--checkpoint-every"
+ * is accepted as the older spelling. */
+static void probe_solver(void)
+{
+	char cmd[PATH_MAX + 32], line[512];
+	snprintf(worker_opt.solver_version, sizeof worker_opt.solver_version, "unknown");
+	snprintf(cmd, sizeof cmd, "'%s' version 2>/dev/null", worker_opt.solver);
+	FILE *p = popen(cmd, "r");
+	if (p) {
+		if (fgets(line, sizeof line, p)) {
+			line[strcspn(line, "\n")] = '\0';
+			const char *v = strncmp(line, "poro-solve ", 11) ? line : line + 11;
+			snprintf(worker_opt.solver_version, sizeof worker_opt.solver_version, "%.100s", v);
+		}
+		pclose(p);
+	}
+	snprintf(cmd, sizeof cmd, "'%s' 2>&1", worker_opt.solver);
+	p = popen(cmd, "r");
+	if (!p)
+		return;
+	while (fgets(line, sizeof line, p)) {
+		if (strstr(line, "--checkpoint-wall"))
+			worker_opt.checkpoint_flag = "--checkpoint-wall";
+		else if (!worker_opt.checkpoint_flag && strstr(line, "--checkpoint-every"))
+			worker_opt.checkpoint_flag = "--checkpoint-every";
+	}
+	pclose(p);
+}
+
+static int parse_flags(int argc, char **argv)
+{
+	const char *solver = NULL, *work = "var/work", *name = NULL;
+	long v;
+	worker_opt.slots = 1;
+	worker_opt.checkpoint_wall = 60;
+	for (int i = 1; i < argc; i++) {
+		const char *a = argv[i], *val = i + 1 < argc ? argv[i + 1] : NULL;
+		if (!val)
+			return usage();
+		i++;
+		if (!strcmp(a, "--server"))
+			snprintf(worker_opt.server, sizeof worker_opt.server, "%s", val);
+		else if (!strcmp(a, "--token"))
+			snprintf(worker_opt.token, sizeof worker_opt.token, "%s", val);
+		else if (!strcmp(a, "--slots") && !parse_long(val, 1, 1024, &v))
+			worker_opt.slots = (int)v;
+		else if (!strcmp(a, "--work"))
+			work = val;
+		else if (!strcmp(a, "--solver"))
+			solver = val;
+		else if (!strcmp(a, "--memory-limit-mb") && !parse_long(val, 0, 1L << 30, &v))
+			worker_opt.memory_limit_mb = v;
+		else if (!strcmp(a, "--checkpoint-wall") && !parse_long(val, 0, 1L << 30, &v))
+			worker_opt.checkpoint_wall = v;
+		else if (!strcmp(a, "--lease-renew") && !parse_long(val, 1, 86400, &v))
+			worker_opt.lease_renew = (double)v;
+		else if (!strcmp(a, "--name"))
+			name = val;
+		else {
+			fprintf(stderr, "poro-worker: bad option '%s %s'\n", a, val);
+			return usage();
+		}
+	}
+	char err[1200] = "";
+	struct client_config cfg = {0};
+	snprintf(cfg.server, sizeof cfg.server, "%s", worker_opt.server);
+	snprintf(cfg.token, sizeof cfg.token, "%s", worker_opt.token);
+	if (client_config_load(&cfg, err, sizeof err) < 0) {
+		fprintf(stderr, "poro-worker: %s\n", err);
+		return 2;
+	}
+	snprintf(worker_opt.server, sizeof worker_opt.server, "%s", cfg.server);
+	snprintf(worker_opt.token, sizeof worker_opt.token, "%s", cfg.token);
+	if (!worker_opt.server[0] || !worker_opt.token[0]) {
+		fprintf(stderr, "poro-worker: no server URL or token (--server/--token, PORO_SERVER/PORO_TOKEN)\n");
+		return 2;
+	}
+	if (find_solver(solver, worker_opt.solver, sizeof worker_opt.solver) < 0) {
+		fprintf(stderr, "poro-worker: cannot find an executable poro-solve%s%s\n", solver ? " at " : "",
+			solver ? solver : "");
+		return 2;
+	}
+	absolute(work, worker_opt.work, sizeof worker_opt.work);
+	gethostname(worker_opt.host, sizeof worker_opt.host - 1);
+	if (name)
+		snprintf(worker_opt.name, sizeof worker_opt.name, "%s", name);
+	else
+		snprintf(worker_opt.name, sizeof worker_opt.name, "%.200s:%d", worker_opt.host, (int)getpid());
+	long cpus = sysconf(_SC_NPROCESSORS_ONLN);
+	worker_opt.threads = cpus > 0 ? (int)cpus : 1;
+	return 0;
+}
+
+/* mkdir -p */
+static int make_dirs(const char *path)
+{
+	char tmp[4096];
+	snprintf(tmp, sizeof tmp, "%s", path);
+	for (char *p = tmp + 1; *p; p++) {
+		if (*p != '/')
+			continue;
+		*p = '\0';
+		if (mkdir(tmp, 0755) < 0 && errno != EEXIST)
+			return -1;
+		*p = '/';
+	}
+	return mkdir(tmp, 0755) < 0 && errno != EEXIST ? -1 : 0;
+}
+
+static void *slot_thread(void *arg)
+{
+	slot_main(arg);
+	atomic_fetch_sub(&slots_running, 1);
+	return NULL;
+}
+
+int main(int argc, char **argv)
+{
+	int rc = parse_flags(argc, argv);
+	if (rc)
+		return rc;
+	if (make_dirs(worker_opt.work) < 0) {
+		fprintf(stderr, "poro-worker: cannot create '%s': %s\n", worker_opt.work, strerror(errno));
+		return 2;
+	}
+	probe_solver();
+	if (http_global_init() < 0) {
+		fprintf(stderr, "poro-worker: cannot initialise libcurl\n");
+		return 1;
+	}
+	signal(SIGPIPE, SIG_IGN);
+	sigset_t set;
+	sigemptyset(&set);
+	sigaddset(&set, SIGTERM);
+	sigaddset(&set, SIGINT);
+	pthread_sigmask(SIG_BLOCK, &set, NULL);
+	worker_say("%s serving %s with %d slot%s, solver %s (%s), work %s", worker_opt.name, worker_opt.server,
+		   worker_opt.slots, worker_opt.slots == 1 ? "" : "s", worker_opt.solver, worker_opt.solver_version,
+		   worker_opt.work);
+	pthread_t *threads = calloc((size_t)worker_opt.slots, sizeof *threads);
+	int started = 0;
+	for (int i = 0; threads && i < worker_opt.slots; i++) {
+		atomic_fetch_add(&slots_running, 1);
+		if (pthread_create(&threads[i], NULL, slot_thread, (void *)(size_t)i)) {
+			atomic_fetch_sub(&slots_running, 1);
+			break;
+		}
+		started++;
+	}
+	int terms = 0;
+	struct timespec tick = {0, 200000000};
+	while (atomic_load(&slots_running) > 0) {
+		int sig = sigtimedwait(&set, NULL, &tick);
+		if (sig != SIGTERM && sig != SIGINT)
+			continue;
+		if (++terms == 1) {
+			worker_say("draining: no new jobs, running jobs finish (signal again to stop them)");
+			atomic_store(&worker_draining, 1);
+		} else {
+			worker_say("stopping: terminating running solvers");
+			atomic_store(&worker_stopping, 1);
+		}
+	}
+	for (int i = 0; i < started; i++)
+		pthread_join(threads[i], NULL);
+	free(threads);
+	http_global_cleanup();
+	worker_say("exiting");
+	return atomic_load(&worker_fatal) ? 1 : 0;
+}

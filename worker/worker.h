@@ -1,0 +1,66 @@
+/*
+ * worker.h - what the parts of poro-worker share: its options, the drain and stop flags set by
+ * signals, the event printer and the clock. poro-worker claims jobs from poro-server over HTTP,
+ * runs each as a poro-solve child process and sends log, progress, files and the outcome back
+ * (docs/service.md §2, §3 "Workers", §5). The files: main.c (flags, signals, slot threads),
+ * slot.c (the claim loop of one slot), job.c (one running job), child.c (the solver process),
+ * log_pump.c (the solver's output), job_files.c (checkpoint download and uploads), backoff.c
+ * (retry delays). The worker keeps no state that matters: losing it loses at most the work since
+ * the job's last uploaded checkpoint.
+ */
+#ifndef PORO_WORKER_H
+#define PORO_WORKER_H
+
+#include <stdatomic.h>
+
+/* Grace between SIGTERM and SIGKILL to a solver's process group, seconds. */
+#define WORKER_KILL_GRACE 5.0
+/* Long-poll length of a claim, seconds (the server allows 0..60). */
+#define WORKER_CLAIM_WAIT 20
+/* Log chunks go out at most this often while output arrives, seconds. */
+#define WORKER_LOG_INTERVAL 0.5
+/* Largest log chunk in one request, bytes (the server refuses bodies over 4 MiB). */
+#define WORKER_LOG_CHUNK (256 * 1024)
+/* Heartbeats go out every lease_seconds / 3, but at least this often, seconds, so that a cancel
+ * reaches the solver within this delay plus WORKER_KILL_GRACE. */
+#define WORKER_HEARTBEAT_MAX 5.0
+/* How long the final log, uploads and finish of a job are retried before the worker gives up,
+ * seconds; and the shorter limit after a second SIGTERM. */
+#define WORKER_FINISH_PATIENCE 300.0
+#define WORKER_STOP_PATIENCE 10.0
+
+struct worker_options {
+	char server[1024];       /* base URL */
+	char token[512];         /* worker token */
+	int slots;               /* jobs run at once */
+	char work[4096];         /* absolute directory holding job-<id>-<attempt>/ */
+	char solver[4096];       /* absolute path of poro-solve */
+	long memory_limit_mb;    /* RLIMIT_AS of a solver, 0: none */
+	long checkpoint_wall;    /* seconds of wall time between checkpoints given to the solver, 0: none */
+	const char *checkpoint_flag; /* the solver's option for it, NULL when the solver has none */
+	double lease_renew;      /* heartbeat interval override, seconds, 0: from the lease */
+	char name[256];          /* "host:pid" unless --name */
+	char host[256];
+	int threads;             /* hardware threads offered in claims */
+	char solver_version[128];
+};
+
+extern struct worker_options worker_opt;
+extern atomic_int worker_draining; /* first SIGTERM: claim nothing more (aborts a long-poll) */
+extern atomic_int worker_stopping; /* second SIGTERM: stop the solvers, report infrastructure */
+extern atomic_int worker_fatal;    /* the server refused the worker's token: exit 1 */
+
+/* Prints one event line "poro-worker: ..." with a UTC time stamp to stdout (thread-safe). */
+void worker_say(const char *fmt, ...) __attribute__((format(printf, 1, 2)));
+
+/* Monotonic seconds. */
+double worker_now(void);
+
+/* Sleeps for seconds, in short steps, returning early when worker_stopping is set, or when
+ * worker_draining is set and wake_on_drain is non-zero. */
+void worker_sleep(double seconds, int wake_on_drain);
+
+/* The claim loop of one slot; arg is the slot's index cast to a pointer. */
+void *slot_main(void *arg);
+
+#endif
