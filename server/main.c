@@ -52,6 +52,7 @@ static const struct option_def OPTIONS[] = {
 	INT_OPT("user-max-running", user_max_running, 0, 100000000, "default per-user cap on running jobs, 0 = unlimited (default 0)"),
 	INT_OPT("max-backoff-seconds", max_backoff_seconds, 1, 86400, "cap of the retry backoff min(2^(attempt-1), cap) (default 60)"),
 	INT_OPT("group-commit-max", group_commit_max, 1, 100000, "most write requests in one transaction (default 1024)"),
+	TEXT_OPT("access-log", access_log, "append 'METHOD ROUTE STATUS MILLISECONDS' per request to FILE (default none)"),
 };
 #define OPTION_COUNT (sizeof OPTIONS / sizeof OPTIONS[0])
 
@@ -319,11 +320,19 @@ int main(int argc, char **argv)
 	pthread_cond_init(&srv.claim_cv, NULL);
 	pthread_cond_init(&srv.log_cv, NULL);
 	srv.metrics = metrics_create();
+	srv.access_log_fd = -1;
+	if (srv.cfg.access_log[0] &&
+	    (srv.access_log_fd = open(srv.cfg.access_log, O_WRONLY | O_CREAT | O_APPEND | O_CLOEXEC, 0644)) < 0) {
+		fprintf(stderr, "poro-server: cannot open --access-log '%s': %s\n", srv.cfg.access_log, strerror(errno));
+		return 2;
+	}
 	if (!srv.metrics) {
 		fprintf(stderr, "poro-server: out of memory\n");
 		return 1;
 	}
 	int rc = serve(&srv);
 	metrics_destroy(&srv.metrics);
+	if (srv.access_log_fd >= 0)
+		close(srv.access_log_fd);
 	return rc;
 }

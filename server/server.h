@@ -35,6 +35,7 @@ struct server_config {
 	int user_max_running;         /* default per-user cap on running jobs; 0 = unlimited */
 	int max_backoff_seconds;      /* cap of the retry backoff min(2^(attempt-1), cap) */
 	int group_commit_max;         /* most write requests in one transaction */
+	char access_log[SERVER_STATE_MAX]; /* one line per answered request, or "" for none */
 };
 
 /*      code                        HTTP  name on the wire */
@@ -103,6 +104,7 @@ struct server {
 	struct server_config cfg;
 	struct store *store;
 	struct metrics *metrics;
+	int access_log_fd;                /* -1 without --access-log */
 	volatile int stopping;            /* set on SIGTERM: long-polls and follows end */
 	pthread_mutex_t wake_lock;
 	pthread_cond_t claim_cv;          /* broadcast when a job may have become claimable */

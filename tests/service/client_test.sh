@@ -59,7 +59,7 @@ wait_for() {
 
 state=$tmp/state
 mkdir -p "$state"
-"$build/poro-server" --listen 127.0.0.1:0 --state "$state" --lease-seconds 3 > "$tmp/server.log" 2>&1 &
+"$build/poro-server" --listen 127.0.0.1:0 --state "$state" --lease-seconds 3 ${SVC_ROUTES_LOG:+--access-log "$SVC_ROUTES_LOG"} > "$tmp/server.log" 2>&1 &
 pids+=($!)
 wait_for 10 test -s "$state/server.url"
 check server_starts $? "no $state/server.url after 10 s: $(tail -3 "$tmp/server.log")"

@@ -46,7 +46,11 @@ svc_start() {
 	local state="$SVC_TMP/$name"
 	mkdir -p "$state"
 	rm -f "$state/server.url"
-	"$SVC_BUILD/poro-server" --listen 127.0.0.1:0 --state "$state" "$@" \
+	# with SVC_ROUTES_LOG set (tests/run.sh does), every answered request is logged there for the
+	# route coverage check (tests/service/route_coverage.sh)
+	local log_args=()
+	[ -n "${SVC_ROUTES_LOG:-}" ] && log_args=(--access-log "$SVC_ROUTES_LOG")
+	"$SVC_BUILD/poro-server" --listen 127.0.0.1:0 --state "$state" "${log_args[@]}" "$@" \
 		> "$SVC_TMP/$name.out" 2> "$SVC_TMP/$name.err" &
 	SVC_PIDS[$name]=$!
 	SVC_STATES[$name]=$state
