@@ -2,13 +2,16 @@
  * poro_load.c - load generator for the job service (make bench, crash tests).
  *
  *   poro-load submit --server URL --token T --case FILE --clients C --count N [--key-prefix P]
- *                    [--record FILE]
+ *                    [--record FILE] [--retry-seconds S] [--pause-ms MS]
  *       N POST /v1/jobs from C threads, each with its own keep-alive connection; submission i
  *       carries Idempotency-Key P-i. Prints
  *       "submissions: N ok, E errors, X.X per second; latency p50 A ms, p90 B ms, p99 C ms, max D ms".
  *       --record writes one line per attempt, "key status job_id" (status 0 when no answer came,
  *       job_id "-" when none), flushed as it goes, so a test that kills the server mid-run can
- *       check that every acknowledged submission survived.
+ *       check that every acknowledged submission survived. With --retry-seconds a submission that
+ *       got no answer or a 5xx is sent again with the same key every 50 ms for up to S seconds, as
+ *       a client relying on Idempotency-Key would; each try is recorded. Latency is the last try's.
+ *       --pause-ms makes each client wait between its submissions (a paced load for crash tests).
  *   poro-load claim --server URL --token WORKER_TOKEN --count N --clients C
  *       claims jobs and finishes each at once as "succeeded"; prints claims per second and claim
  *       latency percentiles. A client stops when the queue stays empty for one short long-poll.
@@ -37,6 +40,8 @@
 struct load {
 	const char *server, *token, *case_file, *key_prefix, *record_path;
 	int clients;
+	double retry_seconds;    /* resend a failed submission for this long (0: never) */
+	long pause_ms;           /* a client's wait between its submissions */
 	long count;
 	int claim_mode;
 	json_t *body;            /* submission body (submit) */
@@ -81,17 +86,33 @@ static void *submit_client(void *arg)
 		snprintf(key, sizeof key, "%s-%ld", l->key_prefix, i);
 		snprintf(header, sizeof header, "Idempotency-Key: %s", key);
 		struct http_response r;
-		double t0 = now_s();
-		long status = http_json(c, "POST", "/v1/jobs", l->body, header, 60, &r);
-		double ms = 1e3 * (now_s() - t0);
-		l->latency_ms[i] = status ? ms : NAN;
-		long long id = status == 200 || status == 201 ? json_get_int(r.json, "id", -1) : -1;
+		long status;
+		long long id;
+		const double first = now_s();
+		for (;;) {
+			double t0 = now_s();
+			status = http_json(c, "POST", "/v1/jobs", l->body, header, 60, &r);
+			double ms = 1e3 * (now_s() - t0);
+			l->latency_ms[i] = status ? ms : NAN;
+			id = status == 200 || status == 201 ? json_get_int(r.json, "id", -1) : -1;
+			int retry = (status == 0 || status >= 500) && now_s() - first < l->retry_seconds;
+			if (!retry)
+				break;
+			record(l, key, status, id);
+			http_response_release(&r);
+			struct timespec pause = {0, 50000000};
+			nanosleep(&pause, NULL);
+		}
 		if (id >= 0)
 			atomic_fetch_add(&l->ok, 1);
 		else
 			atomic_fetch_add(&l->errors, 1);
 		record(l, key, status, id);
 		http_response_release(&r);
+		if (l->pause_ms > 0) {
+			struct timespec pause = {l->pause_ms / 1000, (l->pause_ms % 1000) * 1000000L};
+			nanosleep(&pause, NULL);
+		}
 	}
 	http_client_destroy(&c);
 	return NULL;
@@ -163,7 +184,7 @@ static double percentile(const double *v, size_t n, double q)
 static int usage(void)
 {
 	fprintf(stderr, "usage: poro-load submit --server URL --token T --case FILE --clients C --count N\n"
-			"                        [--key-prefix P] [--record FILE]\n"
+			"                        [--key-prefix P] [--record FILE] [--retry-seconds S] [--pause-ms MS]\n"
 			"       poro-load claim --server URL --token WORKER_TOKEN --count N --clients C\n");
 	return 2;
 }
@@ -192,6 +213,10 @@ static int parse_args(struct load *l, int argc, char **argv)
 			l->clients = atoi(v);
 		else if (!strcmp(a, "--count"))
 			l->count = atol(v);
+		else if (!strcmp(a, "--retry-seconds"))
+			l->retry_seconds = atof(v);
+		else if (!strcmp(a, "--pause-ms"))
+			l->pause_ms = atol(v);
 		else
 			return -1;
 	}
