@@ -527,5 +527,6 @@ void job_run(struct http_client *c, const json_t *claim)
 		log_pump_release(&j.pump);
 	}
 	free(j.chunk);
-	job_files_remove_tree(j.dir);
+	if (!worker_opt.keep_work)   /* kept for inspection: what the solver wrote, byte for byte */
+		job_files_remove_tree(j.dir);
 }

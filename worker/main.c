@@ -3,7 +3,7 @@
  *
  *   poro-worker --server URL --token TOKEN [--slots N (1)] [--work DIR (./var/work)]
  *               [--solver PATH] [--memory-limit-mb N] [--checkpoint-wall SECONDS (60)]
- *               [--lease-renew SECONDS] [--name NAME]
+ *               [--lease-renew SECONDS] [--name NAME] [--keep-work yes|no (no)]
  *
  * The token may come from PORO_TOKEN and the URL from PORO_SERVER (or the config file read by the
  * CLI). The solver defaults to poro-solve next to this binary, else the first on PATH. SIGTERM or
@@ -74,7 +74,7 @@ static int usage(void)
 {
 	fprintf(stderr, "usage: poro-worker --server URL --token TOKEN [--slots N] [--work DIR] [--solver PATH]\n"
 			"                   [--memory-limit-mb N] [--checkpoint-wall SECONDS] [--lease-renew SECONDS]\n"
-			"                   [--name NAME]\n");
+			"                   [--name NAME] [--keep-work yes|no]\n");
 	return 2;
 }
 
@@ -192,6 +192,8 @@ static int parse_flags(int argc, char **argv)
 			worker_opt.lease_renew = (double)v;
 		else if (!strcmp(a, "--name"))
 			name = val;
+		else if (!strcmp(a, "--keep-work") && (!strcmp(val, "yes") || !strcmp(val, "no")))
+			worker_opt.keep_work = !strcmp(val, "yes");
 		else {
 			fprintf(stderr, "poro-worker: bad option '%s %s'\n", a, val);
 			return usage();

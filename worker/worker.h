@@ -39,6 +39,7 @@ struct worker_options {
 	long checkpoint_wall;    /* seconds of wall time between checkpoints given to the solver, 0: none */
 	const char *checkpoint_flag; /* the solver's option for it, NULL when the solver has none */
 	double lease_renew;      /* heartbeat interval override, seconds, 0: from the lease */
+	int keep_work;           /* 1: keep each job's directory after it ends (--keep-work yes) */
 	char name[256];          /* "host:pid" unless --name */
 	char host[256];
 	int threads;             /* hardware threads offered in claims */

@@ -71,7 +71,7 @@ poro=$root/$build/poro
 
 start_worker() { # NAME: starts a worker, its pid in $worker_pid, its log in $tmp/NAME.log
 	"$build/poro-worker" --server "$PORO_SERVER" --token "$worker_token" --work "$tmp/work-$1" \
-		--solver "$build/poro-solve" --checkpoint-wall 1 --name "$1" > "$tmp/$1.log" 2>&1 &
+		--solver "$build/poro-solve" --checkpoint-wall 1 --name "$1" --keep-work yes > "$tmp/$1.log" 2>&1 &
 	worker_pid=$!
 	pids+=($worker_pid)
 }
@@ -105,6 +105,10 @@ got=$(sha256sum "$tmp/fetched/result.h5" 2>/dev/null | cut -d' ' -f1)
 [ -n "$got" ] && [ "$said" = "$got" ] && "$poro" show "$id" | grep -q "result.h5 .* sha256 $got"
 check fetch_matches_listed_sha256 $? "fetch said '$said', file has '$got'"
 
+solver_sha=$(sha256sum "$tmp/work-w1/job-$id-1/out/result.h5" 2>/dev/null | cut -d' ' -f1)
+[ -n "$got" ] && [ "$solver_sha" = "$got" ]
+check fetched_file_is_the_one_the_solver_wrote $? "solver's file '$solver_sha', fetched '$got'"
+
 "$poro" show "$id" > "$tmp/show.txt" 2>&1
 grep -q "^state  *succeeded" "$tmp/show.txt" && grep -q "short-run" "$tmp/show.txt" && grep -q "events:" "$tmp/show.txt"
 check show_lists_fields $? "$(head -5 "$tmp/show.txt")"
@@ -132,11 +136,17 @@ check idempotency_key_reuses_job $? "ids '$a' and '$b'"
 wait_for 30 state_is "$a" succeeded
 
 # ---- logs -f follows a running job to its end -----------------------------------------------------
+# the first solver progress line must reach the follower while the job is still running
 id=$("$poro" submit "$tmp/medium.json")
-timeout 60 "$poro" logs -f "$id" > "$tmp/follow.txt" 2>&1
-rc=$?
-[ $rc -eq 0 ] && grep -q "^done:" "$tmp/follow.txt" && state_is "$id" succeeded
-check logs_follow_until_end $? "exit $rc, state $(job_state "$id"), tail: $(tail -1 "$tmp/follow.txt")"
+state_at_first_line=""
+while IFS= read -r line; do
+	case $line in step*) [ -z "$state_at_first_line" ] && state_at_first_line=$(job_state "$id") ;; esac
+	printf '%s\n' "$line" >> "$tmp/follow.txt"
+done < <(timeout 60 "$poro" logs -f "$id" 2>&1)
+grep -q "^done:" "$tmp/follow.txt" && state_is "$id" succeeded
+check logs_follow_until_end $? "state $(job_state "$id"), tail: $(tail -1 "$tmp/follow.txt")"
+[ "$state_at_first_line" = running ]
+check logs_follow_shows_lines_while_running $? "job was '$state_at_first_line' when the first step line arrived"
 
 # ---- cancel a running job: the solver is gone within seconds --------------------------------------
 id=$("$poro" submit "$tmp/long.json")
