@@ -23,6 +23,7 @@
 #include <arpa/inet.h>
 #include <microhttpd.h>
 #include <netdb.h>
+#include <errno.h>
 #include <stdarg.h>
 #include <stdio.h>
 #include <time.h>
@@ -297,6 +298,18 @@ static enum MHD_Result queue_reply(struct exchange *x)
 	access_log(x, rep->status);
 	x->queued = 1;
 	return ok;
+}
+
+int http_client_gone(struct request *r)
+{
+	const union MHD_ConnectionInfo *info =
+		MHD_get_connection_info(r->connection, MHD_CONNECTION_INFO_CONNECTION_FD);
+	if (!info)
+		return 0;
+	char byte;
+	/* an orderly shutdown reads as 0 bytes; an open idle connection as EAGAIN */
+	ssize_t n = recv(info->connect_fd, &byte, 1, MSG_PEEK | MSG_DONTWAIT);
+	return n == 0 || (n < 0 && errno != EAGAIN && errno != EWOULDBLOCK && errno != EINTR);
 }
 
 /* ---- routing ---- */

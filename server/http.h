@@ -53,6 +53,10 @@ struct request {
 	struct reply reply;
 };
 
+/* 1 if the client has closed its connection (a long-poll whose worker went away must not take a
+ * job), 0 while it is open. */
+int http_client_gone(struct request *r);
+
 /* A request header, or NULL. */
 const char *http_header(struct request *r, const char *name);
 /* A query parameter, percent-decoded into out: 1 if present, 0 if absent, -1 if it does not

@@ -73,6 +73,10 @@ void worker_claim(struct request *r)
 		pthread_mutex_unlock(&srv->wake_lock);
 		json_t *job = NULL;
 		struct api_error err = { 0 };
+		if (http_client_gone(r)) {   /* the worker stopped waiting: a job leased now would be lost */
+			reply_text(r, 204, NULL, NULL, 0);
+			break;
+		}
 		if (store_claim(srv->store, &in, &job, &err) != API_OK) {
 			reply_error(r, &err);
 			break;
