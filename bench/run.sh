@@ -9,3 +9,7 @@ echo "== solver: 2-D elastic block, >= 100,000 soil points"
 "$build"/bench/solver_bench
 "$build"/bench/solver_bench --single-point
 "$build"/bench/solver_bench --projection consistent
+echo "== service: durable submissions, claims, log delay (bench/service.sh)"
+bash bench/service.sh "$build"
+echo "== materials: ns per stress update, elastic and plastic steps (bench/material_bench.c)"
+"$build"/bench/material_bench

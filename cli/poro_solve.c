@@ -3,7 +3,11 @@
  *
  *   poro-solve run CASE.json --out DIR [--resume CHECKPOINT] [--checkpoint-wall SECONDS]
  *                                        run a case, write DIR/result.h5 and DIR/result.xdmf
- *   poro-solve validate CASE.json        check a case; every problem as "JSON-pointer: message"
+ *   poro-solve validate CASE.json        check a case (a simulation case, or an element case by its
+ *                                        "schema"); every problem as "JSON-pointer: message"
+ *   poro-solve element CASE.json --out DIR
+ *                                        single-element triaxial test (element.h, docs/element.md):
+ *                                        DIR/element.csv and DIR/element.svg
  *   poro-solve version
  *
  * run writes DIR/checkpoint.h5 every checkpoint.interval of simulated time (case key) and every
@@ -23,6 +27,7 @@
 
 #include "case.h"
 #include "checkpoint.h"
+#include "element.h"
 #include "poro.h"
 
 #ifndef PORO_VERSION
@@ -41,6 +46,7 @@ static int usage(void)
 {
 	fprintf(stderr, "usage: poro-solve run CASE.json --out DIR [--resume CHECKPOINT] [--checkpoint-wall SECONDS]\n"
 			"       poro-solve validate CASE.json\n"
+			"       poro-solve element CASE.json --out DIR\n"
 			"       poro-solve version\n");
 	return 2;
 }
@@ -68,11 +74,44 @@ static int cmd_validate(const char *path)
 {
 	struct case_spec *c = NULL;
 	struct poro_error err = {0};
+	if (element_case_file_is_element(path)) {
+		struct element_case e;
+		enum poro_status st = element_case_load_file(path, &e, &err);
+		if (st)
+			return fail(st, &err, path);
+		printf("%s: valid element case\n", path);
+		return 0;
+	}
 	enum poro_status st = case_load_file(path, &c, &err);
 	if (st)
 		return fail(st, &err, path);
 	printf("%s: valid\n", path);
 	case_destroy(&c);
+	return 0;
+}
+
+/* element CASE.json --out DIR: an element case (its own schema, "poro-element/1") through the
+ * single-element driver. */
+static int cmd_element(const char *path, const char *out_dir)
+{
+	struct element_case c;
+	struct element_result r = {0};
+	struct poro_error err = {0};
+	enum poro_status st = element_case_load_file(path, &c, &err);
+	if (st)
+		return fail(st, &err, path);
+	st = element_run(&c, &r, &err);
+	if (!st)
+		st = element_write(&c, &r, out_dir, &err);
+	if (st) {
+		element_result_release(&r);
+		return fail(st, &err, path);
+	}
+	const struct element_row *last = &r.row[r.rows - 1];
+	printf("%d steps: axial strain %.6g, p = %.6g Pa, q = %.6g Pa, volumetric strain %.6g\n", r.rows - 1,
+	       last->axial_strain, last->p, last->q, last->volumetric_strain);
+	printf("done: %s/element.csv, %s/element.svg\n", out_dir, out_dir);
+	element_result_release(&r);
 	return 0;
 }
 
@@ -157,5 +196,7 @@ int main(int argc, char **argv)
 		return cmd_validate(argv[2]);
 	if (argc >= 3 && !strcmp(argv[1], "run"))
 		return parse_run(argc, argv);
+	if (argc == 5 && !strcmp(argv[1], "element") && !strcmp(argv[3], "--out"))
+		return cmd_element(argv[2], argv[4]);
 	return usage();
 }

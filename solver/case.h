@@ -27,7 +27,14 @@ enum pressure_projection { PROJECTION_LAPLACIAN, PROJECTION_CONSISTENT };
  * change (Eqs. 79-80). */
 enum soil_stabilisation { STABILISATION_NONE, STABILISATION_FBAR };
 
-enum material_model { MODEL_LINEAR_ELASTIC, MODEL_HENCKY };
+/* Constitutive models (material.h), one file each: "linear_elastic" (small strain), "hencky" (finite
+ * strain), and the Mohr-Coulomb family returned in principal stress space (principal_return.h):
+ * "mohr_coulomb", "tresca_softening" (001 §4.2.1), "mohr_coulomb_dilation" (001 Eq. 17). */
+enum material_model { MODEL_LINEAR_ELASTIC, MODEL_HENCKY, MODEL_MOHR_COULOMB, MODEL_TRESCA_SOFTENING,
+		      MODEL_MOHR_COULOMB_DILATION };
+/* Kinematics of a plastic model: finite strain (Be, logarithmic strain, Kirchhoff stress, 000 Eqs.
+ * 69-76; the default) or small strain (the symmetric part of dF - I). */
+enum material_strain { STRAIN_FINITE, STRAIN_SMALL };
 
 /* constant; Kozeny-Carman k = C1 n^3 / (1 - n)^2 (000 step 8g); volume_ratio k = k0 V / V0, Xie and
  * Leo's assumption that k falls with (1 + e) as m_v does, under which 000 Eq. 87 holds. */
@@ -66,10 +73,24 @@ struct case_grid {
 
 struct case_material {
 	char name[CASE_NAME_MAX];
-	enum material_model model;        /* "linear_elastic" (small strain) or "hencky" (finite strain) */
+	enum material_model model;        /* "linear_elastic" (small strain), "hencky" (finite strain) or a
+					     plastic model (below) */
 	double density;                   /* soil grain density rho_s, kg/m^3 */
 	double youngs_modulus;            /* E, Pa, > 0 */
 	double poisson_ratio;             /* nu, -1 < nu < 0.5 */
+	/* Plastic models only (case_material.c says which model takes which key). Angles in degrees
+	 * as given; material_init() converts and applies the strength reduction. */
+	enum material_strain strain;      /* "finite" (default) or "small" */
+	double cohesion;                  /* c, Pa, >= 0 (mohr_coulomb, mohr_coulomb_dilation) */
+	double friction_angle;            /* phi, degrees, 0 < phi < 90 (Mohr-Coulomb models) */
+	double dilation_angle;            /* psi, degrees, 0 <= psi <= phi (mohr_coulomb) */
+	double peak_cohesion;             /* c_p, Pa, > 0 (tresca_softening) */
+	double residual_cohesion;         /* c_r, Pa, 0 <= c_r <= c_p (tresca_softening) */
+	double residual_plastic_strain;   /* eps_p^r: deviatoric plastic strain at which c_r is reached, > 0 */
+	double initial_dilation_angle;    /* psi_ini, degrees, -phi <= psi_ini <= phi (mohr_coulomb_dilation) */
+	double critical_dilation_angle;   /* psi_crit, degrees, -phi <= psi_crit <= phi */
+	double dilation_evolution_parameter; /* eta >= 0 of 001 Eq. 17, per unit deviatoric plastic strain */
+	double strength_reduction_factor; /* SRF >= 1, default 1 (000 Eq. 91) */
 };
 
 #define CASE_POLYGON_MAX 64

@@ -58,6 +58,10 @@ const char *case_quote(char *dst, const char *s);
 #define CASE_NUMBER_SIZE 32
 const char *case_format_number(char *dst, double x);
 
+/* Reads a whole file into a NUL-terminated heap string the caller frees (case_load.c). PORO_EIO
+ * naming the path when it cannot be read; PORO_EINVAL ("/: malformed JSON") when it holds a NUL. */
+enum poro_status case_read_text(const char *path, char **text, struct poro_error *err);
+
 /* Parses text. On malformed JSON records "/: malformed JSON at line L column C: why" and returns
  * NULL. The root must be an object. Frees with case_json_free(). */
 json_t *case_json_parse(struct case_reader *r, const char *text);

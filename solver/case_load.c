@@ -26,6 +26,7 @@
 #include <string.h>
 
 #include "case_json.h"
+#include "case_material.h"
 
 /* Defaults of optional values (documented in schemas/case.schema.json and docs/case-spec.md). */
 #define DEFAULT_FLUID_DENSITY 1000.0      /* kg/m^3, water */
@@ -47,7 +48,6 @@ static const struct case_range POSITIVE = { BOUND_OPEN, 0, BOUND_NONE, 0 };
 static const struct case_range NON_NEGATIVE = { BOUND_CLOSED, 0, BOUND_NONE, 0 };
 static const struct case_range FRACTION = { BOUND_CLOSED, 0, BOUND_CLOSED, 1 };
 static const struct case_range POROSITY = { BOUND_OPEN, 0, BOUND_OPEN, 1 };
-static const struct case_range POISSON_RATIO = { BOUND_OPEN, -1, BOUND_OPEN, 0.5 };
 
 /* Names of enum values, in enum order. */
 static const char *const schema_names[] = { CASE_SCHEMA_VERSION, NULL };
@@ -56,7 +56,6 @@ static const char *const phases_names[] = { "double_point", "single_point", NULL
 static const char *const shape_names[] = { "linear", "quadratic_bspline", NULL };
 static const char *const projection_names[] = { "laplacian", "consistent", NULL };
 static const char *const stabilisation_names[] = { "none", "fbar", NULL };
-static const char *const model_names[] = { "linear_elastic", "hencky", NULL };
 static const char *const permeability_law_names[] = { "constant", "kozeny_carman", "volume_ratio", NULL };
 static const char *const constraint_names[] = { "free", "slip", "fixed", NULL };
 static const char *const drainage_names[] = { "impermeable", "drained", NULL };
@@ -75,8 +74,8 @@ static const char *const formulation_keys[] = { "scheme", "phases", "shape", "po
 						"flip_fraction", "pressure_projection", "soil_stabilisation",
 						"drag_in_correction", NULL };
 static const char *const grid_keys[] = { "origin", "extent", "cell_size", NULL };
-static const char *const material_keys[] = { "name", "model", "density", "youngs_modulus",
-					     "poisson_ratio", NULL };
+/* A material's own keys; its model's keys are checked by case_read_material_model(). */
+static const char *const material_keys[] = { "name", "density", NULL };
 static const char *const body_keys[] = { "name", "material", "rectangle", "polygon", "particles_per_cell",
 					 "porosity", "hydraulic_conductivity", "permeability_law", NULL };
 static const char *const box_keys[] = { "min", "max", NULL };
@@ -286,12 +285,9 @@ static int read_grid(struct case_reader *r, const json_t *root, struct case_grid
 
 static void read_material(struct case_reader *r, const json_t *o, const char *p, struct case_material *m)
 {
-	case_check_keys(r, o, p, material_keys);
 	case_read_name(r, o, p, "name", CASE_REQUIRED, m->name, sizeof m->name);
-	m->model = read_choice_or(r, o, p, "model", CASE_REQUIRED, model_names, m->model);
+	case_read_material_model(r, o, p, material_keys, m);
 	case_read_number(r, o, p, "density", CASE_REQUIRED, &POSITIVE, &m->density);
-	case_read_number(r, o, p, "youngs_modulus", CASE_REQUIRED, &POSITIVE, &m->youngs_modulus);
-	case_read_number(r, o, p, "poisson_ratio", CASE_REQUIRED, &POISSON_RATIO, &m->poisson_ratio);
 }
 
 static void read_materials(struct case_reader *r, const json_t *root, struct case_spec *c)
@@ -712,8 +708,7 @@ enum poro_status case_load_string(const char *json, struct case_spec **out, stru
 	return PORO_OK;
 }
 
-/* Reads a whole file into a NUL-terminated heap string. */
-static enum poro_status read_file(const char *path, char **text, struct poro_error *err)
+enum poro_status case_read_text(const char *path, char **text, struct poro_error *err)
 {
 	FILE *f = fopen(path, "rb");
 	if (!f)
@@ -750,7 +745,7 @@ enum poro_status case_load_file(const char *path, struct case_spec **out, struct
 {
 	char *text = NULL;
 	*out = NULL;
-	enum poro_status status = read_file(path, &text, err);
+	enum poro_status status = case_read_text(path, &text, err);
 	if (status != PORO_OK)
 		return status;
 	status = case_load_string(text, out, err);

@@ -5,7 +5,9 @@
  * eigenvalues are the squared principal stretches (Eq. 73); the logarithmic strain is
  * E = 1/2 ln Be (Eqs. 72, 74); the Kirchhoff stress is tau = lambda tr(E) I + 2 mu E, coaxial with
  * Be (Eq. 75 with the elastic operator); the Cauchy stress is sigma = tau / J (Eq. 76).
- * Plane strain: dF_zz = 1, so Be_zz is carried unchanged by elastic steps.
+ * Plane strain: dF_zz = 1, so Be_zz is carried unchanged by elastic steps (the element driver may
+ * stretch z: Be_zz picks up dF_zz^2). Tangent: d tau / d eps_trial is the constant elastic matrix
+ * (material.h).
  */
 #include "material.h"
 
@@ -21,12 +23,13 @@ enum poro_status hencky_update(const struct material *m, struct stress_update *u
 	double bxx = a0 * f[0] + a1 * f[1];
 	double bxy = a0 * f[2] + a1 * f[3];
 	double byy = b0 * f[2] + b1 * f[3];
+	double bzz = u->dF_zz != 0.0 ? u->dF_zz * Be[3] * u->dF_zz : Be[3];
 	double l[2], theta;
 	sym2_eigen(bxx, byy, bxy, l, &theta);
-	if (!(l[1] > 0.0) || !(Be[3] > 0.0) || !(u->J > 0.0))
+	if (!(l[1] > 0.0) || !(bzz > 0.0) || !(u->J > 0.0))
 		return poro_error_set(err, PORO_ESOLVER, "hencky: non-positive stretch (%.3g, %.3g), J = %.3g",
 				      l[0], l[1], u->J);
-	double e1 = 0.5 * log(l[0]), e2 = 0.5 * log(l[1]), ez = 0.5 * log(Be[3]);
+	double e1 = 0.5 * log(l[0]), e2 = 0.5 * log(l[1]), ez = 0.5 * log(bzz);
 	double lt = m->lambda * (e1 + e2 + ez);
 	double t1 = lt + 2.0 * m->mu * e1, t2 = lt + 2.0 * m->mu * e2, tz = lt + 2.0 * m->mu * ez;
 	double c = cos(theta), s = sin(theta), invJ = 1.0 / u->J;
@@ -34,7 +37,9 @@ enum poro_status hencky_update(const struct material *m, struct stress_update *u
 	u->stress[1] = (s * s * t1 + c * c * t2) * invJ;
 	u->stress[2] = c * s * (t1 - t2) * invJ;
 	u->stress[3] = tz * invJ;
-	Be[0] = bxx, Be[1] = byy, Be[2] = bxy;
+	Be[0] = bxx, Be[1] = byy, Be[2] = bxy, Be[3] = bzz;
+	if (u->tangent)
+		material_elastic_tangent(m, u->tangent);
 	return PORO_OK;
 }
 

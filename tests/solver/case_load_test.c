@@ -11,6 +11,7 @@
  * the root, so a relative __FILE__ means the tests run from there too).
  */
 #include "case.h"
+#include "element.h"
 
 #include <glob.h>
 #include <jansson.h>
@@ -469,10 +470,17 @@ static void repository_root(char *root, size_t size)
 	snprintf(root, size, "%.*s", (int)n, __FILE__);
 }
 
+/* A simulation case, or an element case (element.h) by its schema. */
 static void load_file_ok(const char *name, const char *path)
 {
 	struct case_spec *c = NULL;
 	struct poro_error err = { 0 };
+	if (element_case_file_is_element(path)) {
+		struct element_case e;
+		enum poro_status st = element_case_load_file(path, &e, &err);
+		CHECK(st == PORO_OK, name, "%s: %s", path, err.message);
+		return;
+	}
 	enum poro_status status = case_load_file(path, &c, &err);
 	CHECK(status == PORO_OK && c != NULL, name, "%s: %s", path, err.message);
 	case_destroy(&c);
