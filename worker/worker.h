@@ -17,13 +17,17 @@
 #define WORKER_KILL_GRACE 5.0
 /* Long-poll length of a claim, seconds (the server allows 0..60). */
 #define WORKER_CLAIM_WAIT 20
-/* Log chunks go out at most this often while output arrives, seconds. */
-#define WORKER_LOG_INTERVAL 0.5
+/* Log chunks go out at most this often while output arrives, seconds: a follower sees a solver
+ * line within about this plus the server's wake-up (make bench measures it; the aim is < 0.5 s),
+ * and a chatty solver costs the server at most 1 / WORKER_LOG_INTERVAL requests a second. */
+#define WORKER_LOG_INTERVAL 0.1
 /* Largest log chunk in one request, bytes (the server refuses bodies over 4 MiB). */
 #define WORKER_LOG_CHUNK (256 * 1024)
-/* Heartbeats go out every lease_seconds / 3, but at least this often, seconds, so that a cancel
- * reaches the solver within this delay plus WORKER_KILL_GRACE. */
-#define WORKER_HEARTBEAT_MAX 5.0
+/* Heartbeats go out every lease_seconds / 3, but at least this often, seconds: a cancel is
+ * answered on a heartbeat, so the solver gets its SIGTERM within this delay (it stops within a
+ * step; SIGKILL follows WORKER_KILL_GRACE later if it does not), well inside the 5 s a cancelled
+ * solver may take to disappear. One request a second per running job is nothing for the server. */
+#define WORKER_HEARTBEAT_MAX 1.0
 /* How long the final log, uploads and finish of a job are retried before the worker gives up,
  * seconds; and the shorter limit after a second SIGTERM. */
 #define WORKER_FINISH_PATIENCE 300.0
