@@ -1,0 +1,65 @@
+#!/usr/bin/env bash
+# failures_test.sh - how jobs fail, with a real poro-server, poro-worker and poro-solve:
+#   - a solver failure (a case that passes validation but blows up: dt far above the soil's
+#     stable step) is final: state failed after one attempt, never retried, with the solver's own
+#     message (which point, where, why) kept on the job;
+#   - a job over its wall-time limit is stopped by the worker and fails with a message saying so,
+#     its solver gone, not retried.
+#   bash tests/service/failures_test.sh BUILD_DIR
+set -u
+build=${1:-build}
+cd "$(dirname "$0")/../.."
+. tests/service/lib.sh
+svc_init "$build"
+worker=""
+trap '[ -n "$worker" ] && kill -TERM "$worker" 2>/dev/null && wait "$worker"; svc_cleanup' EXIT
+
+cp "$build/poro-solve" "$SVC_TMP/poro-solve"
+svc_start main --lease-seconds 3
+check server_starts $? "no server"
+alice=$(svc_token main alice user)
+pool=$(svc_token main pool worker)
+"$build/poro-worker" --server "$SVC_URL" --token "$pool" --work "$SVC_TMP/work" --solver "$SVC_TMP/poro-solve" \
+	--name w > "$SVC_TMP/w.log" 2>&1 &
+worker=$!
+
+python3 - tests/cases/terzaghi.json "$SVC_TMP" <<'EOF'
+import json, sys
+c = json.load(open(sys.argv[1]))
+blow = dict(c, time={"dt": 0.05, "end": 20.0})
+json.dump({"case": blow}, open(sys.argv[2] + "/blow.json", "w"))
+json.dump({"case": c, "wall_time_seconds": 1}, open(sys.argv[2] + "/slow.json", "w"))
+EOF
+submit() { # BODY-FILE: prints the job id
+	code=$(svc_req POST /v1/jobs "$alice" -H 'Content-Type: application/json' --data-binary "@$SVC_TMP/$1")
+	[ "$code" = 201 ] && json '["id"]' < "$SVC_BODY"
+}
+field() { svc_req GET "/v1/jobs/$1" "$alice" > /dev/null && json "[\"$2\"]" < "$SVC_BODY"; }
+ended() { case $(field "$1" state) in succeeded|failed|cancelled) return 0 ;; esac; return 1; }
+wait_for() { local t=$1 i; shift; for i in $(seq $((t * 10))); do "$@" && return 0; sleep 0.1; done; return 1; }
+
+# ---- a solver failure is final, with its message --------------------------------------------------
+id=$(submit blow.json)
+wait_for 60 ended "$id"
+check solver_failure_ends $? "state $(field "$id" state)"
+state=$(field "$id" state) attempt=$(field "$id" attempt) message=$(field "$id" message)
+[ "$state" = failed ] && [ "$attempt" = 1 ]
+check solver_failure_is_final "$?" "state $state after $attempt attempts"
+echo "$message" | grep -q "soil point [0-9]* at (.*) m: .*porosity outside (0, 1)"
+check solver_failure_message_kept $? "message: $message"
+sleep 4   # more than a lease and a backoff: a retry would have shown by now
+[ "$(field "$id" state)" = failed ] && [ "$(field "$id" attempt)" = 1 ]
+check solver_failure_not_retried $? "state $(field "$id" state), attempt $(field "$id" attempt)"
+
+# ---- the wall-time limit ----------------------------------------------------------------------------
+id=$(submit slow.json)
+wait_for 30 ended "$id"
+check wall_time_job_ends $? "state $(field "$id" state) after 30 s"
+state=$(field "$id" state) message=$(field "$id" message)
+[ "$state" = failed ] && echo "$message" | grep -q "wall time limit of 1 s exceeded"
+check wall_time_limit_fails_job $? "state $state, message: $message"
+pid=$(sed -n "s/.*job $id attempt 1: solver started (pid \([0-9]*\).*/\1/p" "$SVC_TMP/w.log")
+[ -n "$pid" ] && ! kill -0 "$pid" 2>/dev/null
+check wall_time_solver_gone $? "solver pid '$pid' still running"
+[ "$(field "$id" attempt)" = 1 ]
+check wall_time_not_retried $? "attempt $(field "$id" attempt)"
