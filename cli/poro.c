@@ -166,7 +166,8 @@ static int wait_job(long long id)
 			return rc;
 		}
 		const char *state = json_get_str(r.json, "state", "?");
-		draw_progress(id, r.json, tty, &last_decile, last_state);
+		if (tty || !terminal(state))   /* the final state gets its own line below */
+			draw_progress(id, r.json, tty, &last_decile, last_state);
 		if (terminal(state)) {
 			if (tty)
 				fputc('\n', stderr);
