@@ -17,6 +17,7 @@
 #include "store.h"
 
 #include "digest.h"
+#include "fs.h"
 
 #include <errno.h>
 #include <fcntl.h>
@@ -38,20 +39,6 @@ struct upload {
 	char expected[DIGEST_HEX_SIZE];
 	char tmp[SERVER_PATH_MAX + 256], final[SERVER_PATH_MAX + 256];
 };
-
-static int make_dirs(const char *path)
-{
-	char buf[SERVER_PATH_MAX];
-	snprintf(buf, sizeof buf, "%s", path);
-	for (char *p = buf + 1; *p; p++)
-		if (*p == '/') {
-			*p = '\0';
-			if (mkdir(buf, 0755) != 0 && errno != EEXIST)
-				return -1;
-			*p = '/';
-		}
-	return mkdir(buf, 0755) != 0 && errno != EEXIST ? -1 : 0;
-}
 
 static int checksum_header(struct request *r, char out[DIGEST_HEX_SIZE])
 {
@@ -96,7 +83,7 @@ void files_upload_begin(struct request *r)
 	}
 	char dir[SERVER_PATH_MAX], token[DIGEST_TOKEN_SIZE];
 	snprintf(dir, sizeof dir, "%s/files/%lld/%d", r->srv->cfg.state, r->id, u->attempt);
-	if (make_dirs(dir) != 0 || digest_new_token(token) != 0) {
+	if (fs_make_dirs(dir) != 0 || digest_new_token(token) != 0) {
 		reply_fail(r, API_INTERNAL, "", "cannot create '%s': %s", dir, strerror(errno));
 		return;
 	}

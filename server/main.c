@@ -14,6 +14,7 @@
 #include "store.h"
 
 #include "digest.h"
+#include "fs.h"
 
 #include <errno.h>
 #include <fcntl.h>
@@ -176,24 +177,10 @@ static int parse_args(struct server_config *cfg, int argc, char **argv)
 	return 0;
 }
 
-static int make_dir(const char *path)
-{
-	char buf[SERVER_PATH_MAX];
-	snprintf(buf, sizeof buf, "%s", path);
-	for (char *p = buf + 1; *p; p++)
-		if (*p == '/') {
-			*p = '\0';
-			if (mkdir(buf, 0755) != 0 && errno != EEXIST)
-				return -1;
-			*p = '/';
-		}
-	return mkdir(buf, 0755) != 0 && errno != EEXIST ? -1 : 0;
-}
-
 static int open_store(struct server_config *cfg, struct server *srv, struct store **store)
 {
 	char path[SERVER_PATH_MAX + 16];
-	if (make_dir(cfg->state) != 0) {
+	if (fs_make_dirs(cfg->state) != 0) {
 		fprintf(stderr, "poro-server: cannot create state directory '%s': %s\n", cfg->state, strerror(errno));
 		return -1;
 	}

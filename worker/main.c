@@ -29,6 +29,7 @@
 #include "client_config.h"
 #include "http_client.h"
 #include "worker.h"
+#include "fs.h"
 
 struct worker_options worker_opt;
 atomic_int worker_draining;
@@ -229,22 +230,6 @@ static int parse_flags(int argc, char **argv)
 	return 0;
 }
 
-/* mkdir -p */
-static int make_dirs(const char *path)
-{
-	char tmp[4096];
-	snprintf(tmp, sizeof tmp, "%s", path);
-	for (char *p = tmp + 1; *p; p++) {
-		if (*p != '/')
-			continue;
-		*p = '\0';
-		if (mkdir(tmp, 0755) < 0 && errno != EEXIST)
-			return -1;
-		*p = '/';
-	}
-	return mkdir(tmp, 0755) < 0 && errno != EEXIST ? -1 : 0;
-}
-
 static void *slot_thread(void *arg)
 {
 	slot_main(arg);
@@ -257,7 +242,7 @@ int main(int argc, char **argv)
 	int rc = parse_flags(argc, argv);
 	if (rc)
 		return rc;
-	if (make_dirs(worker_opt.work) < 0) {
+	if (fs_make_dirs(worker_opt.work) < 0) {
 		fprintf(stderr, "poro-worker: cannot create '%s': %s\n", worker_opt.work, strerror(errno));
 		return 2;
 	}
