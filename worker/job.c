@@ -308,6 +308,12 @@ static const char *outcome(struct job *j, char *message, size_t size, int *exit_
 		snprintf(message, size, "cannot start the solver '%s'", worker_opt.solver);
 		return "infrastructure";
 	}
+	if (code == 5 && worker_opt.memory_limit_mb > 0) {
+		/* the job needs more than the memory it is given: every retry would end the same way */
+		snprintf(message, size, "out of memory within the worker's limit of %ld MB%s%s", worker_opt.memory_limit_mb,
+			 err[0] ? ": " : "", err);
+		return "failed";
+	}
 	if (err[0])
 		snprintf(message, size, "%s", err);
 	else

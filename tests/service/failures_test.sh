@@ -4,7 +4,9 @@
 #     stable step) is final: state failed after one attempt, never retried, with the solver's own
 #     message (which point, where, why) kept on the job;
 #   - a job over its wall-time limit is stopped by the worker and fails with a message saying so,
-#     its solver gone, not retried.
+#     its solver gone, not retried;
+#   - a job that needs more memory than the worker's --memory-limit-mb fails, final, saying so;
+#   - every job records the solver version, the SHA-256 of its case and the worker's host.
 #   bash tests/service/failures_test.sh BUILD_DIR
 set -u
 build=${1:-build}
@@ -29,6 +31,8 @@ c = json.load(open(sys.argv[1]))
 blow = dict(c, time={"dt": 0.05, "end": 20.0})
 json.dump({"case": blow}, open(sys.argv[2] + "/blow.json", "w"))
 json.dump({"case": c, "wall_time_seconds": 1}, open(sys.argv[2] + "/slow.json", "w"))
+huge = dict(c, grid=dict(c["grid"], extent=[100.0, 100.0]))   # 16 million nodes
+json.dump({"case": huge}, open(sys.argv[2] + "/huge.json", "w"))
 EOF
 submit() { # BODY-FILE: prints the job id
 	code=$(svc_req POST /v1/jobs "$alice" -H 'Content-Type: application/json' --data-binary "@$SVC_TMP/$1")
@@ -63,3 +67,27 @@ pid=$(sed -n "s/.*job $id attempt 1: solver started (pid \([0-9]*\).*/\1/p" "$SV
 check wall_time_solver_gone $? "solver pid '$pid' still running"
 [ "$(field "$id" attempt)" = 1 ]
 check wall_time_not_retried $? "attempt $(field "$id" attempt)"
+
+# ---- provenance: solver version, case hash, worker host ----------------------------------------------
+svc_req GET "/v1/jobs/$id" "$alice" > /dev/null
+python3 - "$SVC_BODY" "$("$SVC_TMP/poro-solve" version | head -1)" <<'EOF'
+import json, socket, sys
+job = json.load(open(sys.argv[1]))
+ok = job.get("solver_version") and job["solver_version"] in sys.argv[2]
+print("PASS job_records_solver_version" if ok else "FAIL job_records_solver_version: %r vs %r" % (job.get("solver_version"), sys.argv[2]))
+ok = job.get("worker_host") == socket.gethostname()
+print("PASS job_records_worker_host" if ok else "FAIL job_records_worker_host: %r" % job.get("worker_host"))
+ok = isinstance(job.get("case_sha256"), str) and len(job["case_sha256"]) == 64
+print("PASS job_records_case_sha256" if ok else "FAIL job_records_case_sha256: %r" % job.get("case_sha256"))
+EOF
+
+# ---- the memory limit --------------------------------------------------------------------------------
+kill -TERM "$worker" && wait "$worker"
+"$build/poro-worker" --server "$SVC_URL" --token "$pool" --work "$SVC_TMP/work2" --solver "$SVC_TMP/poro-solve" \
+	--name small --memory-limit-mb 300 > "$SVC_TMP/small.log" 2>&1 &
+worker=$!
+id=$(submit huge.json)
+wait_for 60 ended "$id"
+state=$(field "$id" state) message=$(field "$id" message) attempt=$(field "$id" attempt)
+[ "$state" = failed ] && [ "$attempt" = 1 ] && echo "$message" | grep -q "out of memory within the worker's limit of 300 MB: .*cannot allocate"
+check memory_limit_fails_job_final $? "state $state after $attempt attempts, message: $message"
