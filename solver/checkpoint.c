@@ -35,6 +35,7 @@
 #include <string.h>
 #include <unistd.h>
 
+#include "hdf5_attr.h"
 #include "hdf5_reason.h"
 #include "sim_internal.h"
 
@@ -111,84 +112,18 @@ static enum poro_status h5_fail(struct sim *s, enum poro_status code, const char
 	return st;
 }
 
-/* ---- small HDF5 helpers: each returns < 0 on failure, the reason in hdf5_reason ---------------- */
-
-static int attr_put(hid_t loc, const char *name, hid_t file_type, hid_t mem_type, const void *value)
-{
-	hid_t space = H5Screate(H5S_SCALAR);
-	if (space < 0)
-		return -1;
-	hid_t a = H5Acreate2(loc, name, file_type, space, H5P_DEFAULT, H5P_DEFAULT);
-	int rc = a < 0 || H5Awrite(a, mem_type, value) < 0 ? -1 : 0;
-	if (a >= 0 && H5Aclose(a) < 0)
-		rc = -1;
-	H5Sclose(space);
-	return rc;
-}
-
-static int attr_get(hid_t loc, const char *name, hid_t mem_type, void *value)
-{
-	hid_t a = H5Aopen(loc, name, H5P_DEFAULT);
-	if (a < 0)
-		return -1;
-	int rc = H5Aread(a, mem_type, value) < 0 ? -1 : 0;
-	return H5Aclose(a) < 0 ? -1 : rc;
-}
-
-static hid_t string_type(void)
-{
-	hid_t t = H5Tcopy(H5T_C_S1);
-	if (t >= 0 && (H5Tset_size(t, H5T_VARIABLE) < 0 || H5Tset_cset(t, H5T_CSET_UTF8) < 0)) {
-		H5Tclose(t);
-		return -1;
-	}
-	return t;
-}
-
-static int attr_put_string(hid_t loc, const char *name, const char *value)
-{
-	hid_t t = string_type();
-	int rc = t < 0 ? -1 : attr_put(loc, name, t, t, &value);
-	if (t >= 0)
-		H5Tclose(t);
-	return rc;
-}
-
-/* A variable-length string attribute as a malloc'ed copy, NULL on failure. */
-static char *attr_get_string(hid_t loc, const char *name)
-{
-	hid_t t = string_type();
-	char *value = NULL, *copy = NULL;
-	if (t >= 0 && attr_get(loc, name, t, &value) == 0 && value) {
-		copy = strdup(value);
-		H5free_memory(value);
-	}
-	if (t >= 0)
-		H5Tclose(t);
-	return copy;
-}
+/* ---- small HDF5 helpers (hdf5_attr.h): each returns < 0 on failure, the reason in hdf5_reason -- */
 
 static int new_group(hid_t file, const char *path)
 {
-	hid_t g = H5Gcreate2(file, path, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
-	return g < 0 || H5Gclose(g) < 0 ? -1 : 0;
+	return hdf5_group_create(file, path, 0);
 }
 
-/* A contiguous dataset of n rows x width (1-D for width 1). */
+/* A contiguous dataset of n rows x width (1-D for width 1) of doubles, or of ints if is_int. */
 static int put_dataset(hid_t file, const char *path, hsize_t n, int width, int is_int, const void *data)
 {
-	hsize_t dims[2] = {n, (hsize_t)width};
-	hid_t space = H5Screate_simple(width == 1 ? 1 : 2, dims, NULL);
-	if (space < 0)
-		return -1;
-	hid_t file_type = is_int ? H5T_STD_I32LE : H5T_IEEE_F64LE;
-	hid_t mem_type = is_int ? H5T_NATIVE_INT : H5T_NATIVE_DOUBLE;
-	hid_t ds = H5Dcreate2(file, path, file_type, space, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
-	int rc = ds < 0 || (n > 0 && H5Dwrite(ds, mem_type, H5S_ALL, H5S_ALL, H5P_DEFAULT, data) < 0) ? -1 : 0;
-	if (ds >= 0 && H5Dclose(ds) < 0)
-		rc = -1;
-	H5Sclose(space);
-	return rc;
+	return hdf5_dataset_write(file, path, n, (hsize_t)width, is_int ? H5T_STD_I32LE : H5T_IEEE_F64LE,
+				  is_int ? H5T_NATIVE_INT : H5T_NATIVE_DOUBLE, data);
 }
 
 /* Rows of a dataset whose shape must be rows x width (1-D for width 1); -1 on failure or another
@@ -231,18 +166,18 @@ static enum poro_status write_set(struct sim *s, hid_t file, const char *set, co
 static enum poro_status write_contents(struct sim *s, hid_t file, const char *tmp)
 {
 	hid_t root = H5Gopen2(file, "/", H5P_DEFAULT);
-	int rc = root < 0 || attr_put_string(root, "format", CHECKPOINT_FORMAT) < 0 ||
-		 attr_put(root, "step", H5T_STD_I64LE, H5T_NATIVE_LONG, &s->step) < 0 ||
-		 attr_put(root, "time", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, &s->time) < 0 ||
-		 attr_put(root, "dt", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, &s->dt) < 0 ||
-		 attr_put(root, "water_outflow_mass", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE,
+	int rc = root < 0 || hdf5_attr_write_string(root, "format", CHECKPOINT_FORMAT) < 0 ||
+		 hdf5_attr_write(root, "step", H5T_STD_I64LE, H5T_NATIVE_LONG, &s->step) < 0 ||
+		 hdf5_attr_write(root, "time", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, &s->time) < 0 ||
+		 hdf5_attr_write(root, "dt", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, &s->dt) < 0 ||
+		 hdf5_attr_write(root, "water_outflow_mass", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE,
 			  &s->water_outflow_mass) < 0 ? -1 : 0;
 	if (root >= 0 && H5Gclose(root) < 0)
 		rc = -1;
 	if (rc < 0)
 		return h5_fail(s, PORO_EIO, "write", "/", tmp);
 	hid_t c = new_group(file, "/case") < 0 ? -1 : H5Gopen2(file, "/case", H5P_DEFAULT);
-	rc = c < 0 || attr_put_string(c, "json", s->spec->json) < 0 ? -1 : 0;
+	rc = c < 0 || hdf5_attr_write_string(c, "json", s->spec->json) < 0 ? -1 : 0;
 	if (c >= 0 && H5Gclose(c) < 0)
 		rc = -1;
 	if (rc < 0)
@@ -403,7 +338,7 @@ static enum poro_status read_set(struct sim *s, hid_t file, const char *set, str
 static enum poro_status check_case(struct sim *s, hid_t file, const char *name)
 {
 	hid_t c = H5Gopen2(file, "/case", H5P_DEFAULT);
-	char *json = c < 0 ? NULL : attr_get_string(c, "json");
+	char *json = c < 0 ? NULL : hdf5_attr_read_string(c, "json");
 	if (c >= 0)
 		H5Gclose(c);
 	if (!json)
@@ -424,11 +359,11 @@ static enum poro_status read_header(struct sim *s, hid_t file, const char *name,
 				    double *outflow)
 {
 	hid_t root = H5Gopen2(file, "/", H5P_DEFAULT);
-	char *format = root < 0 ? NULL : attr_get_string(root, "format");
+	char *format = root < 0 ? NULL : hdf5_attr_read_string(root, "format");
 	double dt = 0.0;
-	int rc = !format || attr_get(root, "step", H5T_NATIVE_LONG, step) < 0 ||
-		 attr_get(root, "time", H5T_NATIVE_DOUBLE, time) < 0 || attr_get(root, "dt", H5T_NATIVE_DOUBLE, &dt) < 0 ||
-		 attr_get(root, "water_outflow_mass", H5T_NATIVE_DOUBLE, outflow) < 0 ? -1 : 0;
+	int rc = !format || hdf5_attr_read(root, "step", H5T_NATIVE_LONG, step) < 0 ||
+		 hdf5_attr_read(root, "time", H5T_NATIVE_DOUBLE, time) < 0 || hdf5_attr_read(root, "dt", H5T_NATIVE_DOUBLE, &dt) < 0 ||
+		 hdf5_attr_read(root, "water_outflow_mass", H5T_NATIVE_DOUBLE, outflow) < 0 ? -1 : 0;
 	if (root >= 0)
 		H5Gclose(root);
 	enum poro_status st = PORO_OK;

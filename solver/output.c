@@ -37,6 +37,7 @@
 #include <unistd.h>
 
 #include "case.h"
+#include "hdf5_attr.h"
 #include "hdf5_reason.h"
 
 #include "output_xdmf.h"
@@ -103,37 +104,21 @@ static enum poro_status no_memory(struct poro_error *err, const char *what)
 	return poro_error_set(err, PORO_ENOMEM, "cannot allocate %s", what);
 }
 
-/* ---- small HDF5 helpers: each returns < 0 on failure, the reason recorded in hdf5_reason ------ */
-
-static int attr_write(hid_t loc, const char *name, hid_t file_type, hid_t mem_type, const void *value)
-{
-	htri_t exists = H5Aexists(loc, name);
-	if (exists < 0 || (exists > 0 && H5Adelete(loc, name) < 0))
-		return -1;
-	hid_t space = H5Screate(H5S_SCALAR);
-	if (space < 0)
-		return -1;
-	hid_t a = H5Acreate2(loc, name, file_type, space, H5P_DEFAULT, H5P_DEFAULT);
-	int rc = a < 0 || H5Awrite(a, mem_type, value) < 0 ? -1 : 0;
-	if (a >= 0 && H5Aclose(a) < 0)
-		rc = -1;
-	H5Sclose(space);
-	return rc;
-}
+/* ---- small HDF5 helpers (hdf5_attr.h): each returns < 0 on failure, the reason in hdf5_reason -- */
 
 static int attr_string(const struct output *o, hid_t loc, const char *name, const char *value)
 {
-	return attr_write(loc, name, o->string, o->string, &value);
+	return hdf5_attr_write(loc, name, o->string, o->string, &value);
 }
 
 static int attr_double(hid_t loc, const char *name, double value)
 {
-	return attr_write(loc, name, H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, &value);
+	return hdf5_attr_write(loc, name, H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, &value);
 }
 
 static int attr_long(hid_t loc, const char *name, long value)
 {
-	return attr_write(loc, name, H5T_STD_I64LE, H5T_NATIVE_LONG, &value);
+	return hdf5_attr_write(loc, name, H5T_STD_I64LE, H5T_NATIVE_LONG, &value);
 }
 
 /* Attributes on the object at an absolute path. */
@@ -146,38 +131,14 @@ static int path_attr_string(const struct output *o, const char *path, const char
 	return H5Oclose(obj) < 0 ? -1 : rc;
 }
 
-static int new_group(hid_t loc, const char *path, size_t heap_hint)
-{
-	hid_t gcpl = H5Pcreate(H5P_GROUP_CREATE);
-	if (gcpl < 0)
-		return -1;
-	int rc = heap_hint && H5Pset_local_heap_size_hint(gcpl, heap_hint) < 0 ? -1 : 0;
-	hid_t g = rc ? -1 : H5Gcreate2(loc, path, H5P_DEFAULT, gcpl, H5P_DEFAULT);
-	if (g < 0 || H5Gclose(g) < 0)
-		rc = -1;
-	H5Pclose(gcpl);
-	return rc;
-}
-
 /* A contiguous dataset of n rows and width columns (width 1: 1-D) of file_type, written from data
  * in mem_type, with a "units" attribute when units is not NULL. */
 static int put_dataset(const struct output *o, const char *path, hsize_t n, hsize_t width, hid_t file_type,
 		       hid_t mem_type, const void *data, const char *units)
 {
-	hsize_t dims[2] = {n, width};
-	hid_t space = H5Screate_simple(width == 1 ? 1 : 2, dims, NULL);
-	if (space < 0)
+	if (hdf5_dataset_write(o->file, path, n, width, file_type, mem_type, data) < 0)
 		return -1;
-	hid_t ds = H5Dcreate2(o->file, path, file_type, space, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
-	int rc = ds < 0 ? -1 : 0;
-	if (!rc && n > 0 && H5Dwrite(ds, mem_type, H5S_ALL, H5S_ALL, H5P_DEFAULT, data) < 0)
-		rc = -1;
-	if (!rc && units && attr_string(o, ds, "units", units) < 0)
-		rc = -1;
-	if (ds >= 0 && H5Dclose(ds) < 0)
-		rc = -1;
-	H5Sclose(space);
-	return rc;
+	return units ? path_attr_string(o, path, "units", units) : 0;
 }
 
 /* ---- one point set of a frame ------------------------------------------------------------------ */
@@ -308,7 +269,7 @@ static enum poro_status write_set(struct output *o, const char *frame_path, cons
 	enum poro_status st = scratch_reserve(o, 9 * (size_t)p->n, err);
 	if (st)
 		return st;
-	if (new_group(o->file, group, 0) < 0)
+	if (hdf5_group_create(o->file, group, 0) < 0)
 		return h5_fail(o, err, "create", group);
 	for (size_t k = 0; k < sizeof set_fields / sizeof set_fields[0]; k++) {
 		const struct field *f = &set_fields[k];
@@ -353,7 +314,7 @@ static enum poro_status probes_create(struct output *o, struct poro_error *err)
 	for (int j = 0; j < o->probe_count; j++) {
 		struct output_probe *pr = &o->probes[j];
 		snprintf(path, sizeof path, "/probes/%s", pr->name);
-		if (new_group(o->file, path, 0) < 0)
+		if (hdf5_group_create(o->file, path, 0) < 0)
 			return h5_fail(o, err, "create", path);
 		snprintf(path, sizeof path, "/probes/%s/time", pr->name);
 		if ((pr->time = probe_dataset(o, path, "s")) < 0)
@@ -472,20 +433,20 @@ static enum poro_status file_create(struct output *o, const char *case_json, con
 	if (o->string < 0 || H5Tset_size(o->string, H5T_VARIABLE) < 0 ||
 	    H5Tset_cset(o->string, H5T_CSET_UTF8) < 0)
 		return h5_fail(o, err, "create", "string type");
-	if (new_group(o->file, "/case", 0) < 0 || path_attr_string(o, "/case", "json", case_json) < 0)
+	if (hdf5_group_create(o->file, "/case", 0) < 0 || path_attr_string(o, "/case", "json", case_json) < 0)
 		return h5_fail(o, err, "write", "/case");
 	char now[32];
 	iso_time_now(now, sizeof now);
-	if (new_group(o->file, "/run", 0) < 0 ||
+	if (hdf5_group_create(o->file, "/run", 0) < 0 ||
 	    path_attr_string(o, "/run", "solver_version", solver_version) < 0 ||
 	    path_attr_string(o, "/run", "start_time", now) < 0 ||
 	    path_attr_string(o, "/run", "status", "running") < 0)
 		return h5_fail(o, err, "write", "/run");
-	if (new_group(o->file, "/frames", OUTPUT_FRAME_NAMES_HINT) < 0)
+	if (hdf5_group_create(o->file, "/frames", OUTPUT_FRAME_NAMES_HINT) < 0)
 		return h5_fail(o, err, "create", "/frames");
-	if (new_group(o->file, "/probes", 0) < 0)
+	if (hdf5_group_create(o->file, "/probes", 0) < 0)
 		return h5_fail(o, err, "create", "/probes");
-	if (new_group(o->file, "/xdmf", 0) < 0)
+	if (hdf5_group_create(o->file, "/xdmf", 0) < 0)
 		return h5_fail(o, err, "create", "/xdmf");
 	enum poro_status st = probes_create(o, err);
 	return st ? st : file_sync(o, err);
@@ -591,7 +552,7 @@ enum poro_status output_create(struct output **out, const char *dir, const char 
 static enum poro_status frame_groups(struct output *o, const char *path, const struct output_frame *f,
 				     struct poro_error *err)
 {
-	if (new_group(o->file, path, 0) < 0)
+	if (hdf5_group_create(o->file, path, 0) < 0)
 		return h5_fail(o, err, "create", path);
 	hid_t g = H5Gopen2(o->file, path, H5P_DEFAULT);
 	int rc = g < 0 || attr_double(g, "time", f->time) < 0 || attr_long(g, "step", f->step) < 0 ? -1 : 0;
