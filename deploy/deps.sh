@@ -10,6 +10,7 @@ packages=(
   libhdf5-dev hdf5-tools  # results; h5dump for inspecting
   libmicrohttpd-dev     # server HTTP
   libsqlite3-dev        # server store
+  sqlite3               # the sqlite3 shell, used by the service tests
   libcurl4-openssl-dev  # worker and CLI HTTP client
   python3               # test harness helpers
 )

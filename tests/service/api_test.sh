@@ -421,6 +421,40 @@ svc_req GET "/v1/jobs/$cj" "$ua" > /dev/null
 check lease_expiry_with_cancel_requested_cancels $? "job $cj: $(head -c 300 "$SVC_BODY")"
 svc_stop short
 
+# ---- priority within a user, and a per-user cap on running jobs ----------------------------------
+svc_start prio || { echo "FAIL start_prio: server did not start"; exit 1; }
+boss=$(svc_token prio boss admin)
+dave=$(svc_token prio dave user)
+wp=$(svc_token prio wp worker)
+for prio in 1 5 -3 3; do
+	body "$tmp/prio$prio.json" "b['priority'] = $prio"
+	submit "$dave" "$tmp/prio$prio.json" > /dev/null
+done
+order=""
+for i in 1 2 3 4; do
+	claim "$wp" > /dev/null
+	order="$order $(json '["job"]["id"]' < "$SVC_BODY")"
+done
+[ "$order" = " 2 4 1 3" ]
+check priority_orders_a_users_jobs $? "claimed job ids$order, expected priorities 5, 3, 1, -3 (jobs 2 4 1 3)"
+svc_req POST /v1/users "$boss" -d '{"name": "erin", "role": "user", "max_running": 1}' > /dev/null
+svc_req POST /v1/tokens "$boss" -d '{"user": "erin"}' > /dev/null
+erin=$(json '["token"]' < "$SVC_BODY")
+submit "$erin" "$bodyfile" > /dev/null
+submit "$erin" "$bodyfile" > /dev/null
+claim "$wp" > /dev/null
+e1=$(json '["job"]["id"]' < "$SVC_BODY")
+e1a=$(json '["job"]["attempt"]' < "$SVC_BODY")
+code=$(claim "$wp")
+[ -n "$e1" ] && [ "$code" = 204 ]
+check running_cap_holds_second_job $? "first claim got '$e1', second claim answered $code"
+svc_req POST "/v1/worker/jobs/$e1/finish" "$wp" -d "{\"attempt\": $e1a, \"outcome\": \"succeeded\", \"message\": null, \"exit_code\": 0}" > /dev/null
+code=$(claim "$wp")
+e2=$(json '["job"]["id"]' < "$SVC_BODY")
+[ "$code" = 200 ] && [ -n "$e2" ] && [ "$e2" != "$e1" ]
+check running_cap_releases_after_finish $? "claim after the finish answered $code with job '$e2'"
+svc_stop prio
+
 # ---- a database newer than the binary is refused ------------------------------------------------
 sqlite3 "$SVC_TMP/short/poro.db" "INSERT INTO schema_migrations (version, applied_at) VALUES (999, 0)"
 "$build/poro-server" --listen 127.0.0.1:0 --state "$SVC_TMP/short" > /dev/null 2> "$tmp/newer.err"
