@@ -13,6 +13,7 @@ packages=(
   sqlite3               # the sqlite3 shell, used by the service tests
   libcurl4-openssl-dev  # worker and CLI HTTP client
   python3               # test harness helpers
+  curl procps           # the service tests speak HTTP with curl and find processes with pgrep
 )
 
 # The OpenAPI linter of make test (tools/openapi-lint, pinned in its package-lock.json) runs on
