@@ -1,7 +1,8 @@
 /*
  * material_bench.c - nanoseconds per stress update of each constitutive model (material.h),
  * elastic and plastic steps separately, small and finite strain, with and without the consistent
- * tangent. Printed, never asserted; bench/run.sh runs it.
+ * tangent. Printed, never asserted; bench/run.sh runs it. Nor-Sand (000 Table 6 parameters) starts
+ * its elastic steps from an overconsolidated state and its plastic ones from OCR = 1.
  *
  * Each timed update starts from the same point state (restored by a copy of 16 doubles, included
  * in the figure) and applies the same dF: a small in-plane shear-and-compression increment from a
@@ -78,6 +79,11 @@ static void bench(const char *label, const struct case_material *spec)
 	material_init(&m, spec);
 	int kinds = spec->model == MODEL_LINEAR_ELASTIC || spec->model == MODEL_HENCKY ? 1 : 2;
 	for (int plastic_step = 0; plastic_step < kinds; plastic_step++) {
+		/* nor_sand: elastic steps from an overconsolidated state (OCR 4), plastic ones from OCR 1 */
+		struct case_material variant = *spec;
+		variant.overconsolidation_ratio = plastic_step ? 1.0 : 4.0;
+		if (spec->model == MODEL_NOR_SAND)
+			material_init(&m, &variant);
 		make_states(&m, plastic_step ? 2e-2 : 1e-5, start, dF);
 		for (int tangent = 0; tangent < 2; tangent++) {
 			int plastic;
@@ -95,7 +101,15 @@ int main(void)
 				      .friction_angle = 30, .dilation_angle = 5, .peak_cohesion = 2e4,
 				      .residual_cohesion = 1e4, .residual_plastic_strain = 0.5,
 				      .initial_dilation_angle = -5, .critical_dilation_angle = 0,
-				      .dilation_evolution_parameter = 25, .strength_reduction_factor = 1 };
+				      .dilation_evolution_parameter = 25, .strength_reduction_factor = 1,
+				      /* nor_sand: 000 Table 6 (Hostun sand), v0 = 1.7 */
+				      .shear_modulus = 40e6, .swelling_index = 0.002, .compression_index = 0.02,
+				      .reference_specific_volume = 1.892, .critical_state_reference_pressure = 1e3,
+				      .critical_stress_ratio = 1.0, .yield_function_constant = 0.1,
+				      .plastic_potential_constant = 0.1, .hardening_coefficient = 100,
+				      .dilatancy_multiplier = -2.0, .initial_specific_volume = 1.7,
+				      .overconsolidation_ratio = 1, .initial_reference_pressure = 2e3,
+				      .dilatancy_cutoff_start = 1.0, .dilatancy_cutoff_end = 1.5, .gas_volume_ratio = 1.6 };
 	static const struct { enum material_model model; enum material_strain strain; const char *label; } models[] = {
 		{ MODEL_LINEAR_ELASTIC, STRAIN_SMALL, "linear_elastic" },
 		{ MODEL_HENCKY, STRAIN_FINITE, "hencky" },
@@ -105,6 +119,8 @@ int main(void)
 		{ MODEL_TRESCA_SOFTENING, STRAIN_FINITE, "tresca_softening finite" },
 		{ MODEL_MOHR_COULOMB_DILATION, STRAIN_SMALL, "mohr_coulomb_dilation small" },
 		{ MODEL_MOHR_COULOMB_DILATION, STRAIN_FINITE, "mohr_coulomb_dilation finite" },
+		{ MODEL_NOR_SAND, STRAIN_SMALL, "nor_sand small" },
+		{ MODEL_NOR_SAND, STRAIN_FINITE, "nor_sand finite" },
 	};
 	for (size_t i = 0; i < sizeof models / sizeof models[0]; i++) {
 		struct case_material spec = base;

@@ -28,10 +28,11 @@ enum pressure_projection { PROJECTION_LAPLACIAN, PROJECTION_CONSISTENT };
 enum soil_stabilisation { STABILISATION_NONE, STABILISATION_FBAR };
 
 /* Constitutive models (material.h), one file each: "linear_elastic" (small strain), "hencky" (finite
- * strain), and the Mohr-Coulomb family returned in principal stress space (principal_return.h):
- * "mohr_coulomb", "tresca_softening" (001 §4.2.1), "mohr_coulomb_dilation" (001 Eq. 17). */
+ * strain), the Mohr-Coulomb family returned in principal stress space (principal_return.h):
+ * "mohr_coulomb", "tresca_softening" (001 §4.2.1), "mohr_coulomb_dilation" (001 Eq. 17), and
+ * "nor_sand" (Borja and Andrade's return with 000 App. B.1's changes, material_nor_sand.c). */
 enum material_model { MODEL_LINEAR_ELASTIC, MODEL_HENCKY, MODEL_MOHR_COULOMB, MODEL_TRESCA_SOFTENING,
-		      MODEL_MOHR_COULOMB_DILATION };
+		      MODEL_MOHR_COULOMB_DILATION, MODEL_NOR_SAND };
 /* Kinematics of a plastic model: finite strain (Be, logarithmic strain, Kirchhoff stress, 000 Eqs.
  * 69-76; the default) or small strain (the symmetric part of dF - I). */
 enum material_strain { STRAIN_FINITE, STRAIN_SMALL };
@@ -91,6 +92,23 @@ struct case_material {
 	double critical_dilation_angle;   /* psi_crit, degrees, -phi <= psi_crit <= phi */
 	double dilation_evolution_parameter; /* eta >= 0 of 001 Eq. 17, per unit deviatoric plastic strain */
 	double strength_reduction_factor; /* SRF >= 1, default 1 (000 Eq. 91) */
+	/* nor_sand (000 Table 6 and App. B; youngs_modulus and poisson_ratio are not taken). */
+	double shear_modulus;             /* G, Pa, > 0 (constant) */
+	double swelling_index;            /* kappa > 0: p = p0 exp(-(eps_v^e - eps_v0^e) / kappa) */
+	double compression_index;         /* lambda > 0: slope of the critical state line in v - ln p */
+	double reference_specific_volume; /* v_c0 > 1: v on the critical state line at p = critical_state_reference_pressure */
+	double critical_state_reference_pressure; /* Pa, > 0, default 1000 (v_c0 quoted with p in kPa) */
+	double critical_stress_ratio;     /* M > 0 */
+	double yield_function_constant;   /* N, 0 <= N < 1 */
+	double plastic_potential_constant;/* Nbar, 0 <= Nbar < 1 */
+	double hardening_coefficient;     /* h >= 0 */
+	double dilatancy_multiplier;      /* alpha <= 0: maximum plastic dilatancy D* = alpha psi_i */
+	double initial_specific_volume;   /* v0 > 1 */
+	double overconsolidation_ratio;   /* OCR >= 1, default 1 (000 Eq. 113) */
+	double initial_reference_pressure;/* Pa, > 0, default 2000: p0 of a stress-free point (000 App. B.4) */
+	double dilatancy_cutoff_start;    /* E_d^p,start >= 0, default 1 (000 Eq. 92) */
+	double dilatancy_cutoff_end;      /* E_d^p,end > start, default 1.5 */
+	double gas_volume_ratio;          /* v_crit / v0 > 1, default 1.6 (000 Eqs. 93-94) */
 };
 
 #define CASE_POLYGON_MAX 64

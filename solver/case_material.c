@@ -12,7 +12,7 @@
  */
 #include "case_material.h"
 
-#define KEYS_MAX 24                         /* longest key list, with the caller's own keys */
+#define KEYS_MAX 48                         /* longest key list, with the caller's own keys */
 
 /* Softening no steeper than this multiple of the shear modulus G (Pa per unit deviatoric plastic
  * strain), so that the Tresca return has one solution: in triaxial compression (an edge of the
@@ -26,11 +26,17 @@ static const struct case_range POISSON_RATIO = { BOUND_OPEN, -1, BOUND_OPEN, 0.5
 static const struct case_range FRICTION_ANGLE = { BOUND_OPEN, 0, BOUND_OPEN, 90 };
 
 static const char *const model_names[] = { "linear_elastic", "hencky", "mohr_coulomb", "tresca_softening",
-					   "mohr_coulomb_dilation", NULL };
+					   "mohr_coulomb_dilation", "nor_sand", NULL };
 static const char *const strain_names[] = { "finite", "small", NULL };
 
 /* Keys of each model, in enum order; the last entry is the union. */
 #define ELASTIC_KEYS "model", "youngs_modulus", "poisson_ratio"
+#define NOR_SAND_KEYS "strain", "shear_modulus", "swelling_index", "compression_index",                  \
+		      "reference_specific_volume", "critical_state_reference_pressure", "critical_stress_ratio", \
+		      "yield_function_constant", "plastic_potential_constant", "hardening_coefficient",        \
+		      "dilatancy_multiplier", "initial_specific_volume", "overconsolidation_ratio",            \
+		      "initial_reference_pressure", "dilatancy_cutoff_start", "dilatancy_cutoff_end",          \
+		      "gas_volume_ratio"
 static const char *const *const model_keys[] = {
 	(const char *const[]){ ELASTIC_KEYS, NULL },
 	(const char *const[]){ ELASTIC_KEYS, NULL },
@@ -41,10 +47,11 @@ static const char *const *const model_keys[] = {
 	(const char *const[]){ ELASTIC_KEYS, "strain", "cohesion", "friction_angle", "initial_dilation_angle",
 			       "critical_dilation_angle", "dilation_evolution_parameter",
 			       "strength_reduction_factor", NULL },
+	(const char *const[]){ "model", NOR_SAND_KEYS, NULL },
 	(const char *const[]){ ELASTIC_KEYS, "strain", "cohesion", "friction_angle", "dilation_angle",
 			       "peak_cohesion", "residual_cohesion", "residual_plastic_strain",
 			       "initial_dilation_angle", "critical_dilation_angle",
-			       "dilation_evolution_parameter", "strength_reduction_factor", NULL },
+			       "dilation_evolution_parameter", "strength_reduction_factor", NOR_SAND_KEYS, NULL },
 };
 
 /* Writes the model's keys followed by extra into keys[KEYS_MAX]. */
@@ -120,19 +127,73 @@ static void read_dilation_evolution(struct case_reader *r, const json_t *o, cons
 		     "%s give %s), got %s", case_format_number(got, eta), case_format_number(negated, -eta), got);
 }
 
+/* nor_sand (000 Table 6, App. B.1 and B.4). The elastic constants are G and kappa, not E and nu. */
+static void read_nor_sand(struct case_reader *r, const json_t *o, const char *p, struct case_material *m)
+{
+	static const struct case_range SHAPE_CONSTANT = { BOUND_CLOSED, 0, BOUND_OPEN, 1 };
+	static const struct case_range NON_POSITIVE = { BOUND_NONE, 0, BOUND_CLOSED, 0 };
+	static const struct case_range SPECIFIC_VOLUME = { BOUND_OPEN, 1, BOUND_NONE, 0 };
+	static const struct case_range AT_LEAST_ONE = { BOUND_CLOSED, 1, BOUND_NONE, 0 };
+	char pointer[CASE_POINTER_MAX], a[CASE_NUMBER_SIZE], b[CASE_NUMBER_SIZE];
+	m->critical_state_reference_pressure = 1e3;
+	m->overconsolidation_ratio = 1;
+	m->initial_reference_pressure = 2e3;
+	m->dilatancy_cutoff_start = 1.0;
+	m->dilatancy_cutoff_end = 1.5;
+	m->gas_volume_ratio = 1.6;
+	case_read_number(r, o, p, "shear_modulus", CASE_REQUIRED, &POSITIVE, &m->shear_modulus);
+	case_read_number(r, o, p, "swelling_index", CASE_REQUIRED, &POSITIVE, &m->swelling_index);
+	case_read_number(r, o, p, "compression_index", CASE_REQUIRED, &POSITIVE, &m->compression_index);
+	case_read_number(r, o, p, "reference_specific_volume", CASE_REQUIRED, &SPECIFIC_VOLUME,
+			 &m->reference_specific_volume);
+	case_read_number(r, o, p, "critical_state_reference_pressure", CASE_OPTIONAL, &POSITIVE,
+			 &m->critical_state_reference_pressure);
+	case_read_number(r, o, p, "critical_stress_ratio", CASE_REQUIRED, &POSITIVE, &m->critical_stress_ratio);
+	case_read_number(r, o, p, "yield_function_constant", CASE_REQUIRED, &SHAPE_CONSTANT,
+			 &m->yield_function_constant);
+	case_read_number(r, o, p, "plastic_potential_constant", CASE_REQUIRED, &SHAPE_CONSTANT,
+			 &m->plastic_potential_constant);
+	case_read_number(r, o, p, "hardening_coefficient", CASE_REQUIRED, &NON_NEGATIVE, &m->hardening_coefficient);
+	case_read_number(r, o, p, "dilatancy_multiplier", CASE_REQUIRED, &NON_POSITIVE, &m->dilatancy_multiplier);
+	case_read_number(r, o, p, "initial_specific_volume", CASE_REQUIRED, &SPECIFIC_VOLUME,
+			 &m->initial_specific_volume);
+	case_read_number(r, o, p, "overconsolidation_ratio", CASE_OPTIONAL, &AT_LEAST_ONE, &m->overconsolidation_ratio);
+	case_read_number(r, o, p, "initial_reference_pressure", CASE_OPTIONAL, &POSITIVE,
+			 &m->initial_reference_pressure);
+	case_read_number(r, o, p, "gas_volume_ratio", CASE_OPTIONAL,
+			 &(struct case_range){ BOUND_OPEN, 1, BOUND_NONE, 0 }, &m->gas_volume_ratio);
+	int ok = case_read_number(r, o, p, "dilatancy_cutoff_start", CASE_OPTIONAL, &NON_NEGATIVE,
+				  &m->dilatancy_cutoff_start);
+	ok &= case_read_number(r, o, p, "dilatancy_cutoff_end", CASE_OPTIONAL, &POSITIVE, &m->dilatancy_cutoff_end);
+	if (ok && m->dilatancy_cutoff_end <= m->dilatancy_cutoff_start) {
+		case_pointer_key(pointer, p, "dilatancy_cutoff_end");
+		case_problem(r, pointer, "must be > dilatancy_cutoff_start (%s), got %s",
+			     case_format_number(a, m->dilatancy_cutoff_start),
+			     case_format_number(b, m->dilatancy_cutoff_end));
+	}
+}
+
 void case_read_material_model(struct case_reader *r, const json_t *o, const char *p,
 			      const char *const *extra_keys, struct case_material *m)
 {
 	const char *keys[KEYS_MAX];
-	int model = MODEL_MOHR_COULOMB_DILATION + 1;   /* the union of all keys, until the model is known */
+	int model = MODEL_NOR_SAND + 1;   /* the union of all keys, until the model is known */
 	m->strain = STRAIN_FINITE;
 	m->strength_reduction_factor = 1;
 	case_read_choice(r, o, p, "model", CASE_REQUIRED, model_names, &model);
 	join_keys(model_keys[model], extra_keys, keys);
 	case_check_keys(r, o, p, keys);
+	if (model == MODEL_NOR_SAND) {
+		int strain = STRAIN_FINITE;
+		m->model = MODEL_NOR_SAND;
+		case_read_choice(r, o, p, "strain", CASE_OPTIONAL, strain_names, &strain);
+		m->strain = strain;
+		read_nor_sand(r, o, p, m);
+		return;
+	}
 	int elastic_ok = case_read_number(r, o, p, "youngs_modulus", CASE_REQUIRED, &POSITIVE, &m->youngs_modulus);
 	elastic_ok &= case_read_number(r, o, p, "poisson_ratio", CASE_REQUIRED, &POISSON_RATIO, &m->poisson_ratio);
-	if (model > MODEL_MOHR_COULOMB_DILATION)
+	if (model > MODEL_NOR_SAND)
 		return;
 	m->model = model;
 	if (model == MODEL_LINEAR_ELASTIC || model == MODEL_HENCKY)

@@ -35,11 +35,13 @@ struct element_case {
 	struct case_material material;    /* model and parameters (case_material.h keys) */
 	enum element_test test;           /* "drained" | "undrained" */
 	double confining_pressure;        /* cell pressure, Pa, >= 0 (compression positive) */
-	double axial_strain;              /* final axial strain: eps_a (small) or ln(l / l0) (finite);
-					     non-zero, |axial_strain| < 1; negative = compression */
+	double axial_strain;              /* final axial strain: eps_a (small, |eps_a| < 1) or ln(l / l0)
+					     (finite, |ln(l / l0)| < ELEMENT_LOG_STRAIN_MAX); non-zero;
+					     negative = compression */
 	int steps;                        /* equal axial increments, 1 to ELEMENT_STEPS_MAX */
 };
 #define ELEMENT_STEPS_MAX 1000000
+#define ELEMENT_LOG_STRAIN_MAX 5.0
 
 /* Loads and validates an element case; problems as "JSON-pointer: message" lines, PORO_EINVAL
  * (PORO_EIO for an unreadable file). */

@@ -17,6 +17,8 @@ static const char *const top_keys[] = { "schema", "title", "material", "test", "
 
 static const struct case_range NON_NEGATIVE = { BOUND_CLOSED, 0, BOUND_NONE, 0 };
 static const struct case_range STRAIN = { BOUND_OPEN, -1, BOUND_OPEN, 1 };
+/* finite strain: ln(l / l0), bounded only to keep the stretch representable (l / l0 >= exp(-5)) */
+static const struct case_range LOG_STRAIN = { BOUND_OPEN, -ELEMENT_LOG_STRAIN_MAX, BOUND_OPEN, ELEMENT_LOG_STRAIN_MAX };
 
 static void read_element(struct case_reader *r, const json_t *root, struct element_case *c)
 {
@@ -36,7 +38,9 @@ static void read_element(struct case_reader *r, const json_t *root, struct eleme
 	case_read_choice(r, root, "", "test", CASE_REQUIRED, test_names, &test);
 	c->test = test;
 	case_read_number(r, root, "", "confining_pressure", CASE_REQUIRED, &NON_NEGATIVE, &c->confining_pressure);
-	if (case_read_number(r, root, "", "axial_strain", CASE_REQUIRED, &STRAIN, &c->axial_strain) &&
+	int finite = c->material.model != MODEL_LINEAR_ELASTIC && c->material.strain == STRAIN_FINITE;
+	if (case_read_number(r, root, "", "axial_strain", CASE_REQUIRED, finite ? &LOG_STRAIN : &STRAIN,
+			     &c->axial_strain) &&
 	    c->axial_strain == 0)
 		case_problem(r, "/axial_strain", "must not be 0");
 	case_read_int(r, root, "", "steps", CASE_REQUIRED, 1, ELEMENT_STEPS_MAX, &c->steps);

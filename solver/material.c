@@ -30,6 +30,31 @@ static void init_plastic(struct material *m, const struct case_material *spec)
 	}
 }
 
+/* Nor-Sand: the shear modulus is mu; Young's modulus and the Lame lambda have no meaning (the bulk
+ * modulus p / kappa depends on the pressure) and stay 0. */
+static void init_nor_sand(struct material *m, const struct case_material *spec)
+{
+	struct nor_sand_parameters *n = &m->ns;
+	m->mu = spec->shear_modulus;
+	m->E = m->nu = m->lambda = m->bulk = m->constrained = 0.0;
+	n->kappa = spec->swelling_index;
+	n->lambda = spec->compression_index;
+	n->v_c0 = spec->reference_specific_volume;
+	n->p_ref = spec->critical_state_reference_pressure > 0 ? spec->critical_state_reference_pressure : 1e3;
+	n->M = spec->critical_stress_ratio;
+	n->N = spec->yield_function_constant;
+	n->N_bar = spec->plastic_potential_constant;
+	n->h = spec->hardening_coefficient;
+	n->alpha = spec->dilatancy_multiplier;
+	n->v0 = spec->initial_specific_volume;
+	n->ocr = spec->overconsolidation_ratio > 0 ? spec->overconsolidation_ratio : 1.0;
+	n->p_start = spec->initial_reference_pressure > 0 ? spec->initial_reference_pressure : 2e3;
+	n->cutoff_start = spec->dilatancy_cutoff_start;
+	n->cutoff_end = spec->dilatancy_cutoff_end > spec->dilatancy_cutoff_start ? spec->dilatancy_cutoff_end
+										 : spec->dilatancy_cutoff_start + 0.5;
+	n->gas_ratio = spec->gas_volume_ratio > 1 ? spec->gas_volume_ratio : 1.6;
+}
+
 void material_init(struct material *m, const struct case_material *spec)
 {
 	memset(m, 0, sizeof *m);
@@ -44,7 +69,9 @@ void material_init(struct material *m, const struct case_material *spec)
 	m->bulk = m->lambda + 2.0 * m->mu / 3.0;
 	m->constrained = m->lambda + 2.0 * m->mu;
 	m->cos_phi = 1.0;
-	if (m->model != MODEL_LINEAR_ELASTIC && m->model != MODEL_HENCKY)
+	if (m->model == MODEL_NOR_SAND)
+		init_nor_sand(m, spec);
+	else if (m->model != MODEL_LINEAR_ELASTIC && m->model != MODEL_HENCKY)
 		init_plastic(m, spec);
 }
 
@@ -56,6 +83,10 @@ int material_is_finite_strain(const struct material *m)
 void material_init_state(const struct material *m, const double *stress, double *Be, double *state)
 {
 	memset(state, 0, sizeof(double) * STATE_MAX);
+	if (m->model == MODEL_NOR_SAND) {
+		nor_sand_init_state(m, stress, Be, state);
+		return;
+	}
 	if (material_is_finite_strain(m)) {
 		hencky_init_state(m, stress, Be);
 		return;
@@ -78,6 +109,8 @@ enum poro_status material_update(const struct material *m, struct stress_update 
 		return tresca_softening_update(m, u, err);
 	case MODEL_MOHR_COULOMB_DILATION:
 		return mohr_coulomb_dilation_update(m, u, err);
+	case MODEL_NOR_SAND:
+		return nor_sand_update(m, u, err);
 	}
 	return poro_error_set(err, PORO_EINVAL, "unknown material model %d", (int)m->model);
 }
@@ -89,6 +122,8 @@ int material_state_outputs(const struct material *m, const double *state, const 
 	int n = 0;
 	if (m->model == MODEL_LINEAR_ELASTIC || m->model == MODEL_HENCKY)
 		return 0;
+	if (m->model == MODEL_NOR_SAND)
+		return nor_sand_state_outputs(m, state, names, values);
 	if (names)
 		names[n] = eps_d;
 	values[n++] = state[STATE_DEVIATORIC_PLASTIC_STRAIN];

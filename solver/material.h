@@ -9,14 +9,20 @@
  * tensor Be and Kirchhoff stress tau = J sigma' (000 Eqs. 69-76); small-strain models use the
  * symmetric part of dF - I as the strain increment.
  *
- * Models: linear_elastic (small strain), hencky (finite strain), and the Mohr-Coulomb family
+ * Models: linear_elastic (small strain), hencky (finite strain), the Mohr-Coulomb family
  * (mohr_coulomb, tresca_softening, mohr_coulomb_dilation; finite or small strain by the case's
- * "strain" key), which share the principal-space return mapping of principal_return.h.
+ * "strain" key), which share the principal-space return mapping of principal_return.h, and
+ * nor_sand (material_nor_sand.c; finite or small strain), whose stress is nonlinear in the elastic
+ * strain: at small strain its Be holds exp(2 eps^e) rather than I.
+ *
+ * J and the specific volume: nor_sand's specific volume is v = J v0 with the J given here (000 Eq.
+ * 95); a scheme with the stabilised Jacobian of Eq. 97 passes that J-bar in J (Eq. 96), which then
+ * also divides tau to give sigma.
  *
  * Internal variables live in the point's state array (STATE_MAX doubles, zero at the start unless
  * init_state says otherwise); a model documents its slots in its file and names the ones worth
- * writing out through material_state_outputs(). A model with its own nonlinear return (Nor-Sand
- * next) adds an enum value, a file with its update, and a case in the dispatch of material.c.
+ * writing out through material_state_outputs(). A model with its own nonlinear return (nor_sand)
+ * has an enum value, a file with its update, and a case in the dispatch of material.c.
  *
  * Consistent tangent (for implicit schemes and the drained element driver). Layout: a 4x4
  * row-major matrix over the components (xx, yy, xy, zz) of stress and strain, with TENSOR shear:
@@ -57,6 +63,14 @@ struct material {
 	double sin_phi, cos_phi, sin_psi; /* of phi and psi */
 	double psi_ini, psi_crit;/* mohr_coulomb_dilation: initial and critical dilation angle, rad */
 	double eta;              /* mohr_coulomb_dilation: decay of 001 Eq. 17 */
+	struct nor_sand_parameters { /* nor_sand (material_nor_sand.c; mu above is G) */
+		double kappa, lambda;    /* swelling and compression index */
+		double v_c0, p_ref;      /* critical state line v_c = v_c0 - lambda ln(p / p_ref); p_ref Pa */
+		double M, N, N_bar, h, alpha;
+		double v0, ocr, p_start; /* initial specific volume, OCR, p0 of a stress-free point (Pa) */
+		double cutoff_start, cutoff_end;   /* 000 Eq. 92 */
+		double gas_ratio;        /* v_crit / v0, 000 Eq. 93 */
+	} ns;
 };
 
 /* One point's stress update. Arrays belong to the particle set. */
@@ -101,6 +115,28 @@ enum poro_status tresca_softening_update(const struct material *m, struct stress
 					 struct poro_error *err);
 enum poro_status mohr_coulomb_dilation_update(const struct material *m, struct stress_update *u,
 					      struct poro_error *err);
+/* State slots of nor_sand (slot 0 is the deviatoric plastic strain, as for the Mohr-Coulomb family). */
+enum nor_sand_slot {
+	NOR_SAND_DEVIATORIC_PLASTIC_STRAIN = 0, /* E_d^p = sum of plastic multipliers (d eps_s^p) */
+	NOR_SAND_IMAGE_PRESSURE,         /* pi_i, Pa, compression positive */
+	NOR_SAND_INITIAL_SPECIFIC_VOLUME,/* v0 of the point: v = J v0 */
+	NOR_SAND_REFERENCE_PRESSURE,     /* p0, Pa, compression positive */
+	NOR_SAND_REFERENCE_STRAIN,       /* eps_v0^e, elastic volumetric strain at p0 (tension positive) */
+	NOR_SAND_CUTOFF_STATE,           /* psi_i when E_d^p last stood at or below the cut-off start */
+	NOR_SAND_SPECIFIC_VOLUME,        /* v after the last update */
+	NOR_SAND_STATE_PARAMETER,        /* psi = v - v_c(p) after the last update */
+};
+enum poro_status nor_sand_update(const struct material *m, struct stress_update *u, struct poro_error *err);
+void nor_sand_init_state(const struct material *m, const double *stress, double *Be, double *state);
+int nor_sand_state_outputs(const struct material *m, const double *state, const char **names, double *values);
+
+/* 000 App. B.4, the end of the elastic gravity loading: takes the point's present elastic state as
+ * the Nor-Sand reference, p0 = the Kirchhoff mean pressure J p (Eq. 111) and eps_v0^e = tr eps^e =
+ * 1/2 ln det Be (Eq. 112), and sets the image pressure from the overconsolidation ratio (Eq. 113);
+ * the deviatoric plastic strain restarts at 0. The specific volume keeps v = J v0 with J counted
+ * from the start, which is Eq. 114. Does nothing for other models. */
+void material_reset_reference(const struct material *m, const double *stress, const double *Be, double J,
+			      double *state);
 
 /* Isotropic elastic tangent lambda 1 x 1 + 2 mu I in the layout above (tensor shear). */
 void material_elastic_tangent(const struct material *m, double *tangent);

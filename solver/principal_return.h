@@ -74,4 +74,29 @@ double principal_yield(const struct material *m, const double s[3], double c);
 enum poro_status principal_update(const struct material *m, plastic_law_fn law, struct stress_update *u,
 				  struct poro_error *err);
 
+/* ---- Spectral kinematics for models with their own return in principal elastic strains ----
+ * (material_nor_sand.c). The model sees the three principal trial elastic strains in slot order
+ * (the larger and the smaller in-plane value, then z; isotropic models need no sorting) and
+ * returns principal stresses, principal elastic strains and, for the tangent, d s / d e_trial.
+ *   finite: Be_trial = dF Be^t dF^T (Eq. 70), e = 1/2 ln of its eigenvalues (Eq. 74);
+ *   small:  Be holds exp(2 eps^e) (so one array carries the elastic strain of both kinematics),
+ *           eps^e_trial = 1/2 ln Be^t + sym(dF - I) and its eigen-decomposition. */
+struct spectral_trial {
+	double e[3];             /* principal trial elastic strains, slot order */
+	double gap;              /* e[0] - e[1], computed without cancellation */
+	double c, s;             /* cosine and sine of the first in-plane eigenvector's angle */
+	double Be[4];            /* Be_trial (small strain: exp(2 eps^e_trial)) */
+};
+
+/* Fills t from the point's Be and dF. PORO_ESOLVER (err names `model`) for a non-positive stretch. */
+enum poro_status spectral_trial(const struct stress_update *u, int finite, struct spectral_trial *t,
+				const char *model, struct poro_error *err);
+
+/* Writes the point's results: Be (Be_trial when elastic, else rebuilt from the principal elastic
+ * strains e on the trial eigenvectors), the Cauchy stress from the principal stresses s (Kirchhoff
+ * at finite strain, divided by u->J), and when u->tangent and Ds are given the 4x4 tangent of
+ * material.h from Ds = d s / d e_trial (slot order). */
+void spectral_finish(struct stress_update *u, int finite, const struct spectral_trial *t, const double s[3],
+		     const double e[3], int elastic, const double Ds[3][3]);
+
 #endif

@@ -103,17 +103,23 @@ static void small_trial(const struct material *m, const struct stress_update *u,
 	t->c = cos(theta), t->s = sin(theta);
 }
 
-static enum poro_status finite_trial(const struct material *m, const struct stress_update *u, struct trial *t,
-				     struct poro_error *err)
+/* Be_trial = dF Be^t dF^T (Eq. 70), Be_zz scaled by dF_zz^2. */
+static void trial_Be(const struct stress_update *u, double out[4])
 {
 	const double *f = u->dF, *Be = u->Be;
 	double fzz = u->dF_zz != 0.0 ? u->dF_zz : 1.0;
 	double a0 = f[0] * Be[0] + f[1] * Be[2], a1 = f[0] * Be[2] + f[1] * Be[1];
 	double b0 = f[2] * Be[0] + f[3] * Be[2], b1 = f[2] * Be[2] + f[3] * Be[1];
-	t->Be[0] = a0 * f[0] + a1 * f[1];
-	t->Be[1] = b0 * f[2] + b1 * f[3];
-	t->Be[2] = a0 * f[2] + a1 * f[3];
-	t->Be[3] = fzz * Be[3] * fzz;
+	out[0] = a0 * f[0] + a1 * f[1];
+	out[1] = b0 * f[2] + b1 * f[3];
+	out[2] = a0 * f[2] + a1 * f[3];
+	out[3] = fzz * Be[3] * fzz;
+}
+
+static enum poro_status finite_trial(const struct material *m, const struct stress_update *u, struct trial *t,
+				     struct poro_error *err)
+{
+	trial_Be(u, t->Be);
 	double l[2], theta;
 	sym2_eigen(t->Be[0], t->Be[1], t->Be[2], l, &theta);
 	if (!(l[1] > 0.0) || !(t->Be[3] > 0.0) || !(u->J > 0.0))
@@ -181,4 +187,64 @@ enum poro_status principal_update(const struct material *m, plastic_law_fn law, 
 		assemble_tangent(Ds, g, t.c, t.s, u->tangent);
 	}
 	return PORO_OK;
+}
+
+/* ---- spectral kinematics for models with their own principal return (principal_return.h) ---- */
+
+enum poro_status spectral_trial(const struct stress_update *u, int finite, struct spectral_trial *t,
+				const char *model, struct poro_error *err)
+{
+	double l[2], theta;
+	if (finite) {
+		trial_Be(u, t->Be);
+		sym2_eigen(t->Be[0], t->Be[1], t->Be[2], l, &theta);
+		if (!(l[1] > 0.0) || !(t->Be[3] > 0.0) || !(u->J > 0.0))
+			return poro_error_set(err, PORO_ESOLVER, "%s: non-positive stretch (%.3g, %.3g, %.3g), "
+					      "J = %.3g", model, l[0], l[1], t->Be[3], u->J);
+		t->e[0] = 0.5 * log(l[0]), t->e[1] = 0.5 * log(l[1]), t->e[2] = 0.5 * log(t->Be[3]);
+		t->gap = 0.5 * log1p((l[0] - l[1]) / l[1]);
+	} else {
+		/* eps^e_trial = 1/2 ln Be^t + sym(dF - I); Be^t holds exp(2 eps^e) */
+		const double *f = u->dF, *Be = u->Be;
+		double dzz = u->dF_zz != 0.0 ? u->dF_zz - 1.0 : 0.0;
+		if (!(Be[0] > 0.0) || !(Be[1] > 0.0) || !(Be[3] > 0.0) || !(u->J > 0.0))
+			return poro_error_set(err, PORO_ESOLVER, "%s: elastic strain record not positive definite", model);
+		double lb[2], tb, e[4];
+		sym2_eigen(Be[0], Be[1], Be[2], lb, &tb);
+		if (!(lb[1] > 0.0))
+			return poro_error_set(err, PORO_ESOLVER, "%s: elastic strain record not positive definite", model);
+		rebuild(0.5 * log(lb[0]), 0.5 * log(lb[1]), cos(tb), sin(tb), e);
+		e[0] += f[0] - 1.0, e[1] += f[3] - 1.0, e[2] += 0.5 * (f[1] + f[2]);
+		e[3] = 0.5 * log(Be[3]) + dzz;
+		sym2_eigen(e[0], e[1], e[2], l, &theta);
+		t->e[0] = l[0], t->e[1] = l[1], t->e[2] = e[3];
+		t->gap = l[0] - l[1];
+		double c = cos(theta), s = sin(theta), in_plane[3];
+		rebuild(exp(2.0 * l[0]), exp(2.0 * l[1]), c, s, in_plane);
+		t->Be[0] = in_plane[0], t->Be[1] = in_plane[1], t->Be[2] = in_plane[2], t->Be[3] = exp(2.0 * e[3]);
+	}
+	t->c = cos(theta), t->s = sin(theta);
+	return PORO_OK;
+}
+
+void spectral_finish(struct stress_update *u, int finite, const struct spectral_trial *t, const double s[3],
+		     const double e[3], int elastic, const double Ds[3][3])
+{
+	double in_plane[3];
+	if (elastic) {
+		memcpy(u->Be, t->Be, sizeof t->Be);
+	} else {
+		rebuild(exp(2.0 * e[0]), exp(2.0 * e[1]), t->c, t->s, in_plane);
+		u->Be[0] = in_plane[0], u->Be[1] = in_plane[1], u->Be[2] = in_plane[2];
+		u->Be[3] = exp(2.0 * e[2]);
+	}
+	double invJ = finite ? 1.0 / u->J : 1.0;
+	rebuild(s[0] * invJ, s[1] * invJ, t->c, t->s, in_plane);
+	u->stress[0] = in_plane[0], u->stress[1] = in_plane[1], u->stress[2] = in_plane[2];
+	u->stress[3] = s[2] * invJ;
+	if (u->tangent && Ds) {
+		double scale = fabs(t->e[0]) + fabs(t->e[1]) + 1.0;
+		double g = fabs(t->gap) > SPIN_LIMIT * scale ? (s[0] - s[1]) / t->gap : Ds[0][0] - Ds[0][1];
+		assemble_tangent(Ds, g, t->c, t->s, u->tangent);
+	}
 }

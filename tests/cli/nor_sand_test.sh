@@ -1,0 +1,97 @@
+#!/usr/bin/env bash
+# nor_sand_test.sh - Nor-Sand parameters through `poro-solve validate`: a simulation case derived
+# from tests/cases/terzaghi.json with a nor_sand material (000 Table 6) is accepted, and each invalid
+# parameter is refused with exit 2 and the JSON pointer of the value; an invalid element case too.
+# (The Nor-Sand element cases themselves run in element_test.sh, which runs every element case.)
+# Prints "PASS name" / "FAIL name: why".
+#   bash tests/cli/nor_sand_test.sh BUILD_DIR      (from the repository root)
+set -u
+build=${1:-build}
+cd "$(dirname "$0")/../.."
+solve="$build/poro-solve"
+tmp=$(mktemp -d)
+trap 'rm -rf "$tmp"' EXIT
+
+check() { # name, condition exit status (0 = holds), why
+	if [ "$2" -eq 0 ]; then echo "PASS $1"; else echo "FAIL $1: $3"; fi
+}
+
+derive() { # NAME PYTHON: $tmp/NAME.json, terzaghi.json with a Hostun nor_sand material m after PYTHON
+	python3 - tests/cases/terzaghi.json "$tmp/$1.json" "$2" <<'EOF2'
+import json, sys
+c = json.load(open(sys.argv[1]))
+m = c["materials"][0]
+for k in ("youngs_modulus", "poisson_ratio"):
+    m.pop(k, None)
+m.update({"model": "nor_sand", "shear_modulus": 40e6, "swelling_index": 0.002, "compression_index": 0.02,
+          "reference_specific_volume": 1.892, "critical_stress_ratio": 1.0, "yield_function_constant": 0.1,
+          "plastic_potential_constant": 0.1, "hardening_coefficient": 100, "dilatancy_multiplier": -2.0,
+          "initial_specific_volume": 1.7})
+exec(sys.argv[3])
+json.dump(c, open(sys.argv[2], "w"), indent=1)
+EOF2
+}
+
+bad() { # NAME POINTER [FILE]
+	local file=${3:-$tmp/$1.json} rc
+	"$solve" validate "$file" > /dev/null 2> "$tmp/err"
+	rc=$?
+	grep -q "^$2: " "$tmp/err"
+	check "validate_nor_sand_$1_exits_2_naming_pointer" $(( rc != 2 || $? != 0 )) \
+		"exit $rc, wanted 2 and '$2: ...' in: $(head -c 300 "$tmp/err")"
+}
+
+derive valid 'm.update({"strain": "small", "overconsolidation_ratio": 1.5, "critical_state_reference_pressure": 1e3, "initial_reference_pressure": 2e3, "dilatancy_cutoff_start": 1.0, "dilatancy_cutoff_end": 1.5, "gas_volume_ratio": 1.6})'
+"$solve" validate "$tmp/valid.json" > /dev/null 2> "$tmp/err"
+rc=$?
+check validate_nor_sand_case_exits_0 $rc "exit $rc: $(head -c 300 "$tmp/err")"
+
+derive N_one 'm["yield_function_constant"] = 1'
+derive N_negative 'm["yield_function_constant"] = -0.1'
+derive Nbar_above_one 'm["plastic_potential_constant"] = 1.2'
+derive shear_modulus_negative 'm["shear_modulus"] = -40e6'
+derive swelling_index_zero 'm["swelling_index"] = 0'
+derive compression_index_missing 'del m["compression_index"]'
+derive critical_stress_ratio_missing 'del m["critical_stress_ratio"]'
+derive alpha_positive 'm["dilatancy_multiplier"] = 2'
+derive hardening_negative 'm["hardening_coefficient"] = -1'
+derive specific_volume_below_one 'm["initial_specific_volume"] = 0.9'
+derive reference_specific_volume_string 'm["reference_specific_volume"] = "1.892"'
+derive ocr_below_one 'm["overconsolidation_ratio"] = 0.8'
+derive cutoff_end_before_start 'm.update({"dilatancy_cutoff_start": 1.5, "dilatancy_cutoff_end": 1.0})'
+derive gas_ratio_one 'm["gas_volume_ratio"] = 1'
+derive youngs_modulus_on_nor_sand 'm["youngs_modulus"] = 1e7'
+derive nor_sand_key_on_mohr_coulomb 'm.clear(); m.update({"name": "soil", "density": 2650, "model": "mohr_coulomb", "youngs_modulus": 1e7, "poisson_ratio": 0.3, "cohesion": 1e4, "friction_angle": 30, "dilation_angle": 0, "shear_modulus": 4e6})'
+
+bad N_one /materials/0/yield_function_constant
+bad N_negative /materials/0/yield_function_constant
+bad Nbar_above_one /materials/0/plastic_potential_constant
+bad shear_modulus_negative /materials/0/shear_modulus
+bad swelling_index_zero /materials/0/swelling_index
+bad compression_index_missing /materials/0/compression_index
+bad critical_stress_ratio_missing /materials/0/critical_stress_ratio
+bad alpha_positive /materials/0/dilatancy_multiplier
+bad hardening_negative /materials/0/hardening_coefficient
+bad specific_volume_below_one /materials/0/initial_specific_volume
+bad reference_specific_volume_string /materials/0/reference_specific_volume
+bad ocr_below_one /materials/0/overconsolidation_ratio
+bad cutoff_end_before_start /materials/0/dilatancy_cutoff_end
+bad gas_ratio_one /materials/0/gas_volume_ratio
+bad youngs_modulus_on_nor_sand /materials/0/youngs_modulus
+bad nor_sand_key_on_mohr_coulomb /materials/0/shear_modulus
+
+# ---- an invalid Nor-Sand element case: validate and element both exit 2 naming the pointer ------
+
+python3 - tests/cases/norsand_undrained_p100.json "$tmp/element_bad.json" <<'EOF2'
+import json, sys
+c = json.load(open(sys.argv[1]))
+c["material"]["yield_function_constant"] = 1.0
+del c["material"]["shear_modulus"]
+json.dump(c, open(sys.argv[2], "w"))
+EOF2
+bad element_N_one /material/yield_function_constant "$tmp/element_bad.json"
+"$solve" element "$tmp/element_bad.json" --out "$tmp/element_bad" > /dev/null 2> "$tmp/err"
+rc=$?
+grep -q "^/material/yield_function_constant: " "$tmp/err" && grep -q "^/material/shear_modulus: " "$tmp/err"
+check element_nor_sand_invalid_case_exits_2_listing_every_problem $(( rc != 2 || $? != 0 )) \
+	"exit $rc, stderr: $(head -c 300 "$tmp/err")"
