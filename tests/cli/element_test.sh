@@ -12,9 +12,7 @@ solve="$build/poro-solve"
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
 
-check() { # name, condition exit status (0 = holds), why
-	if [ "$2" -eq 0 ]; then echo "PASS $1"; else echo "FAIL $1: $3"; fi
-}
+. tests/cli/lib.sh
 
 # ---- every element case runs and writes its two files ------------------------------------------
 
@@ -45,25 +43,9 @@ done
 
 # ---- invalid material parameters: validate exits 2 naming the pointer --------------------------
 
-derive() { # NAME PYTHON: $tmp/NAME.json, terzaghi.json's case c after PYTHON
-	python3 - tests/cases/terzaghi.json "$tmp/$1.json" "$2" <<'EOF2'
-import json, sys
-c = json.load(open(sys.argv[1]))
-m = c["materials"][0]
-m.update({"model": "mohr_coulomb", "cohesion": 2e4, "friction_angle": 30, "dilation_angle": 0})
-exec(sys.argv[3])
-json.dump(c, open(sys.argv[2], "w"), indent=1)
-EOF2
-}
-
-bad() { # NAME POINTER [FILE]
-	local file=${3:-$tmp/$1.json} rc
-	"$solve" validate "$file" > /dev/null 2> "$tmp/err"
-	rc=$?
-	grep -q "^$2: " "$tmp/err"
-	check "validate_$1_exits_2_naming_pointer" $(( rc != 2 || $? != 0 )) \
-		"exit $rc, wanted 2 and '$2: ...' in: $(head -c 300 "$tmp/err")"
-}
+MOHR_COULOMB='{"model": "mohr_coulomb", "cohesion": 2e4, "friction_angle": 30, "dilation_angle": 0}'
+derive() { derive_material "$1" "$MOHR_COULOMB" "$2"; }
+bad() { expect_invalid "$@"; }
 
 derive mohr_coulomb_valid 'm["strain"] = "small"; m["strength_reduction_factor"] = 2'
 "$solve" validate "$tmp/mohr_coulomb_valid.json" > /dev/null 2> "$tmp/err"

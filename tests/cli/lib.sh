@@ -1,0 +1,39 @@
+#!/usr/bin/env bash
+# lib.sh - helpers for the command-line tests: source it after setting $solve (the poro-solve
+# binary) and $tmp (a temporary directory the test removes).
+#
+#   check NAME STATUS WHY                 "PASS NAME" when STATUS is 0, else "FAIL NAME: WHY"
+#   derive_material NAME MATERIAL PYTHON  $tmp/NAME.json: tests/cases/terzaghi.json with its first
+#                                         material updated by the JSON object MATERIAL (keys whose
+#                                         value is null are removed), then the python statement
+#                                         PYTHON run with c (the case) and m (the material)
+#   expect_invalid NAME POINTER [FILE]    `poro-solve validate` of FILE ($tmp/NAME.json) exits 2 and
+#                                         names POINTER; the check is called validate_NAME_...
+
+check() {
+	if [ "$2" -eq 0 ]; then echo "PASS $1"; else echo "FAIL $1: $3"; fi
+}
+
+derive_material() {
+	python3 - tests/cases/terzaghi.json "$tmp/$1.json" "$2" "$3" <<'EOF2'
+import json, sys
+c = json.load(open(sys.argv[1]))
+m = c["materials"][0]
+for k, v in json.loads(sys.argv[3]).items():
+    if v is None:
+        m.pop(k, None)
+    else:
+        m[k] = v
+exec(sys.argv[4])
+json.dump(c, open(sys.argv[2], "w"), indent=1)
+EOF2
+}
+
+expect_invalid() {
+	local file=${3:-$tmp/$1.json} rc
+	"$solve" validate "$file" > /dev/null 2> "$tmp/err"
+	rc=$?
+	grep -q "^$2: " "$tmp/err"
+	check "validate_$1_exits_2_naming_pointer" $(( rc != 2 || $? != 0 )) \
+		"exit $rc, wanted 2 and '$2: ...' in: $(head -c 300 "$tmp/err")"
+}
