@@ -19,13 +19,16 @@
 
 enum case_scheme { SCHEME_SEMI_IMPLICIT };
 enum case_phases { PHASES_DOUBLE_POINT, PHASES_SINGLE_POINT };
-enum case_shape { SHAPE_LINEAR, SHAPE_QUADRATIC_BSPLINE };
+enum case_shape { SHAPE_LINEAR, SHAPE_QUADRATIC_BSPLINE, SHAPE_CUBIC_BSPLINE };
 /* The matrix of the pressure solve: the Laplacian of 000 Eq. 61, or the projection G^T M^-1 G
  * consistent with the velocity correction (docs/numerics.md compares them). */
 enum pressure_projection { PROJECTION_LAPLACIAN, PROJECTION_CONSISTENT };
-/* Soil-phase stabilisation (000 §4.4.2): none, or F-bar with the node-wise averaged volume
- * change (Eqs. 79-80). */
-enum soil_stabilisation { STABILISATION_NONE, STABILISATION_FBAR };
+/* Soil-phase stabilisation (000 §4.4.2, docs/numerics.md): none; F-bar with the node-wise averaged
+ * volume change (Eqs. 79-80); modified F-bar (Eq. 81), which also scales Be^t to the patch-wise
+ * averaged elastic Jacobian (Eqs. 82-83; patch 1.5 h for B-splines, the cell for linear); and the
+ * same with cell-wise patches on any shape (h_patch = h, the comparison of 000 App. A / Fig. 12). */
+enum soil_stabilisation { STABILISATION_NONE, STABILISATION_FBAR, STABILISATION_MODIFIED_FBAR,
+			  STABILISATION_MODIFIED_FBAR_CELLWISE };
 
 /* Constitutive models (material.h), one file each: "linear_elastic" (small strain), "hencky" (finite
  * strain), the Mohr-Coulomb family returned in principal stress space (principal_return.h):
@@ -58,11 +61,12 @@ enum probe_field { FIELD_PORE_PRESSURE, FIELD_STRESS_XX, FIELD_STRESS_YY, FIELD_
 struct case_formulation {
 	enum case_scheme scheme;          /* "semi_implicit" */
 	enum case_phases phases;          /* "double_point" (default) or "single_point" */
-	enum case_shape shape;            /* "linear" or "quadratic_bspline" (default) */
+	enum case_shape shape;            /* "linear", "quadratic_bspline" (default) or "cubic_bspline" */
 	int pore_pressure_smoothing;      /* node-wise smoothing, 000 Eq. 77; default true */
 	double flip_fraction;             /* 1 = pure FLIP (default), 0 = PIC; velocity update blend */
 	enum pressure_projection pressure_projection; /* "laplacian" (default) or "consistent" */
-	enum soil_stabilisation soil_stabilisation;   /* "none" (default) or "fbar" */
+	enum soil_stabilisation soil_stabilisation;   /* "none" (default), "fbar", "modified_fbar" or
+							 "modified_fbar_cellwise" */
 	int drag_in_correction;           /* drag also in the velocity correction (phase_coupling.h); default false */
 };
 

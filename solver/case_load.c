@@ -53,9 +53,10 @@ static const struct case_range POROSITY = { BOUND_OPEN, 0, BOUND_OPEN, 1 };
 static const char *const schema_names[] = { CASE_SCHEMA_VERSION, NULL };
 static const char *const scheme_names[] = { "semi_implicit", NULL };
 static const char *const phases_names[] = { "double_point", "single_point", NULL };
-static const char *const shape_names[] = { "linear", "quadratic_bspline", NULL };
+static const char *const shape_names[] = { "linear", "quadratic_bspline", "cubic_bspline", NULL };
 static const char *const projection_names[] = { "laplacian", "consistent", NULL };
-static const char *const stabilisation_names[] = { "none", "fbar", NULL };
+static const char *const stabilisation_names[] = { "none", "fbar", "modified_fbar", "modified_fbar_cellwise",
+							   NULL };
 static const char *const permeability_law_names[] = { "constant", "kozeny_carman", "volume_ratio", NULL };
 static const char *const constraint_names[] = { "free", "slip", "fixed", NULL };
 static const char *const drainage_names[] = { "impermeable", "drained", NULL };

@@ -1,5 +1,6 @@
 /*
- * shape.c - linear and quadratic B-spline shape functions (see shape.h for the edge treatment).
+ * shape.c - linear, quadratic and cubic B-spline shape functions (see shape.h for the edge
+ * treatments).
  *
  * Local symbols: xi = (x - origin) / h, the coordinate in cells; d = xi - node, the signed distance
  * to a node in cells. Weights are dimensionless, gradients are per metre (multiplied by 1/h).
@@ -10,7 +11,7 @@
 
 int shape_support(enum case_shape kind)
 {
-	return kind == SHAPE_LINEAR ? 2 : 3;
+	return kind == SHAPE_LINEAR ? 2 : kind == SHAPE_CUBIC_BSPLINE ? 4 : 3;
 }
 
 static int linear_1d(double xi, idx_t cells, double inv_h, idx_t *i0, double *w, double *dw)
@@ -55,12 +56,61 @@ static int quadratic_1d(double xi, idx_t cells, double inv_h, idx_t *i0, double 
 	return 0;
 }
 
+/* The uniform cubic B-spline N(d) centred on a node, and dN/dd; zero for |d| >= 2. */
+static void cubic_bspline(double d, double *N, double *dN)
+{
+	double a = fabs(d), sign = d < 0.0 ? -1.0 : 1.0;
+	if (a < 1.0) {
+		*N = 2.0 / 3.0 - a * a + 0.5 * a * a * a;
+		*dN = sign * (-2.0 * a + 1.5 * a * a);
+	} else if (a < 2.0) {
+		double t = 2.0 - a;
+		*N = t * t * t / 6.0;
+		*dN = -sign * 0.5 * t * t;
+	} else {
+		*N = 0.0, *dN = 0.0;
+	}
+}
+
+/* Node-centred cubic B-splines; the ghost nodes -1 and cells + 1 are folded into the grid by linear
+ * extrapolation (shape.h): u_-1 = 2 u_0 - u_1 gives S_0 = N_0 + 2 N_-1 and S_1 = N_1 - N_-1. */
+static int cubic_1d(double xi, idx_t cells, double inv_h, idx_t *i0, double *w, double *dw)
+{
+	idx_t i = (idx_t)floor(xi) - 1;   /* nodes floor(xi) - 1 .. floor(xi) + 2 carry N */
+	if (i < 0)
+		i = 0;
+	if (i > cells - 3)
+		i = cells - 3;             /* needs cells >= 3 (the case loader's minimum) */
+	double Nlo, dNlo, Nhi, dNhi;       /* the ghost nodes' functions */
+	cubic_bspline(xi + 1.0, &Nlo, &dNlo);
+	cubic_bspline(xi - (double)(cells + 1), &Nhi, &dNhi);
+	*i0 = i;
+	for (int a = 0; a < 4; a++) {
+		idx_t node = i + a;
+		double N, dN;
+		cubic_bspline(xi - (double)node, &N, &dN);
+		if (node == 0)
+			N += 2.0 * Nlo, dN += 2.0 * dNlo;
+		else if (node == 1)
+			N -= Nlo, dN -= dNlo;
+		if (node == cells)
+			N += 2.0 * Nhi, dN += 2.0 * dNhi;
+		else if (node == cells - 1)
+			N -= Nhi, dN -= dNhi;
+		w[a] = N;
+		dw[a] = dN * inv_h;
+	}
+	return 0;
+}
+
 int shape_1d(enum case_shape kind, double xi, idx_t cells, double inv_h, idx_t *i0, double *w, double *dw)
 {
 	if (!(xi >= 0.0 && xi <= (double)cells))
 		return -1;
 	if (kind == SHAPE_LINEAR)
 		return linear_1d(xi, cells, inv_h, i0, w, dw);
+	if (kind == SHAPE_CUBIC_BSPLINE)
+		return cubic_1d(xi, cells, inv_h, i0, w, dw);
 	return quadratic_1d(xi, cells, inv_h, i0, w, dw);
 }
 

@@ -1,8 +1,9 @@
 /*
  * shape.h - shape functions S_Ip and gradients for a point's support nodes (000 §4.5 step 1).
  *
- * Kinds: linear (tent, 2x2 nodes) and quadratic B-spline (3x3 nodes, Steffen et al. 2008 style,
- * node-centred). Both are tensor products of 1-D functions.
+ * Kinds: linear (tent, 2x2 nodes), quadratic B-spline (3x3 nodes, Steffen et al. 2008 style,
+ * node-centred) and cubic B-spline (4x4 nodes, node-centred, knots at the nodes). All are tensor
+ * products of 1-D functions.
  *
  * Quadratic B-spline at the grid edges: the standard node-centred basis would need a ghost node
  * beyond the edge. We instead modify the half cell next to an edge so that the basis keeps the
@@ -11,6 +12,18 @@
  * from the edge (in cells), the edge node's function is 1 - s and its neighbour's s; elsewhere the
  * standard pieces apply. Matching value and slope at s = 1/2 with the standard pieces
  * (1/2 (3/2 - s)^2 and 3/4 - (s - 1)^2) shows the modified basis is still C1 and non-negative.
+ *
+ * Cubic B-spline at the grid edges: the standard node-centred basis N_i (support 4 cells) needs a
+ * ghost node -1 (and cells + 1) within one cell of an edge. The ghost node is eliminated by linear
+ * extrapolation, u_-1 = 2 u_0 - u_1, i.e. the boundary-modified basis S_0 = N_0 + 2 N_-1,
+ * S_1 = N_1 - N_-1 (mirrored at the upper edge), all other S_i = N_i. This is the cubic analogue
+ * of the quadratic treatment above, in the spirit of the boundary-modified B-splines of Steffen,
+ * Kirby and Berzins (2008) (not an open knot vector, which would add functions without nodes):
+ * one function per grid node, C2, non-negative (S_1 = 2/3 - t^2 + t^3/3 with
+ * t = 1 - s falls from 2/3 to 0 over the edge cell), partition of unity and linear fields
+ * reproduced exactly (the extrapolation is exact for linear fields), and interpolating at the edge
+ * (S_0 = 2/3 + 2/6 = 1, S_1 = 1/6 - 1/6 = 0 there), so a constraint on edge nodes is an exact wall.
+ * Needs at least 3 cells per direction.
  */
 #ifndef PORO_SHAPE_H
 #define PORO_SHAPE_H

@@ -12,6 +12,7 @@
 #include <string.h>
 #include <time.h>
 
+#include "shape.h"
 #include "sim_internal.h"
 
 static int inside_polygon(const struct case_body *b, double x, double y)
@@ -118,9 +119,11 @@ static enum poro_status allocate_scratch(struct sim *s)
 	s->water_scalar = calloc(nw, sizeof(double));
 	s->water_coef = calloc(nw, sizeof(double));
 	s->cell_fill = calloc((size_t)s->grid.cell_count, sizeof(double));
+	s->patch_mass = calloc((size_t)s->grid.cell_count, sizeof(double));
+	s->patch_mass_Je = calloc((size_t)s->grid.cell_count, sizeof(double));
 	s->probe_point = calloc((size_t)s->spec->probe_count + 1, sizeof(int));
 	if (!s->soil_grad || !s->soil_scalar || !s->soil_coef || !s->water_vec || !s->water_scalar ||
-	    !s->water_coef || !s->cell_fill || !s->probe_point)
+	    !s->water_coef || !s->cell_fill || !s->patch_mass || !s->patch_mass_Je || !s->probe_point)
 		return poro_error_set(&s->err, PORO_ENOMEM, "cannot allocate step workspaces");
 	return PORO_OK;
 }
@@ -142,10 +145,11 @@ static enum poro_status build(struct sim *s)
 	if ((st = particles_init(&s->soil, n, 1, &s->err)))
 		return st;
 	seed_points(s, &s->soil);
-	s->soil.support = c->formulation.shape == SHAPE_LINEAR ? 2 : 3;
+	s->soil.support = shape_support(c->formulation.shape);
 	init_soil_state(s);
 	if ((st = init_water(s)) || (st = allocate_scratch(s)))
 		return st;
+	stabilisation_patches_init(s);
 	if ((st = pressure_system_init(&s->ps, &s->grid, s->soil.support,
 					      c->formulation.pressure_projection, &s->err)))
 		return st;
@@ -194,6 +198,8 @@ void sim_destroy(struct sim **ps)
 	free(s->water_scalar);
 	free(s->water_coef);
 	free(s->cell_fill);
+	free(s->patch_mass);
+	free(s->patch_mass_Je);
 	free(s->probe_point);
 	free(s);
 	*ps = NULL;

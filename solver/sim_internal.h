@@ -53,6 +53,13 @@ struct sim {
 	double *water_coef;           /* [n_water] */
 	double *cell_fill;            /* [cell_count] volume of pressure-carrying points per cell, m^3/m */
 
+	/* Patches of the modified F-bar (000 Eq. 83): a fixed tiling of the grid into
+	 * patches[0] x patches[1] rectangles of patch_width (about h_patch; see semi_implicit.c) */
+	idx_t patches[2];
+	double patch_width[2];        /* m */
+	double *patch_mass;           /* [cell_count >= patch count] sum of m_sp over the patch, kg/m */
+	double *patch_mass_Je;        /* [cell_count] sum of m_sp J^e over the patch */
+
 	double mapped_mass_s, mapped_mass_w; /* point mass sums mapped in the last P2G, kg/m */
 	double water_outflow_mass;    /* kg/m of water points that left through drained faces */
 	double phase_seconds[PHASE_COUNT]; /* wall time per phase, accumulated over steps */
@@ -67,6 +74,8 @@ double sim_clock(void);
 
 /* semi_implicit.c: one step of 000 §4.5. */
 enum poro_status semi_implicit_step(struct sim *s);
+/* semi_implicit.c: lays out the patches of the modified F-bar (000 Eq. 83) once, at create. */
+void stabilisation_patches_init(struct sim *s);
 
 /* pressure.c: free-surface detection and the Poisson solve (000 §4.5 step 5). */
 enum poro_status pressure_system_init(struct pressure_system *ps, const struct grid *g, int support,

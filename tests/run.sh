@@ -2,7 +2,9 @@
 # Runs the test programs and prints one closing line "N passed, N failed, N skipped".
 #   tests/run.sh BUILD_DIR test     unit tests, reduced-size verification, command-line tests
 #   tests/run.sh BUILD_DIR verify   the verification runs alone (tests/verify/); the cases there
-#                                   are already at the papers' sizes, so `make test` includes them
+#                                   are already at the papers' sizes, so `make test` includes them,
+#                                   except runs a program keeps for PORO_VERIFY_LONG=1, which this
+#                                   mode sets (strip_footing_test: finer grids, full load)
 # Each C test prints PASS/FAIL/XFAIL lines; INFO lines carry the measured figures. The full
 # output is kept in BUILD_DIR/test-output.txt.
 set -u
@@ -22,6 +24,7 @@ if [ "$mode" = test ]; then
 	programs+=("bash tests/service/route_coverage.sh $build $SVC_ROUTES_LOG")
 else
 	for t in "$build"/tests/verify/*_test; do [ -x "$t" ] && programs+=("$t"); done
+	export PORO_VERIFY_LONG=1   # verification programs add their long runs (strip_footing_test)
 fi
 
 crashed=0

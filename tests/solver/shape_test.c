@@ -1,7 +1,9 @@
 /*
  * shape_test.c - shape functions (issue item g): partition of unity and zero gradient sum at
  * high-entropy points, including the half cells next to the grid edges; gradients against
- * central finite differences of the weights; non-negativity; the interpolating edge property.
+ * central finite differences of the weights; non-negativity; the interpolating edge property;
+ * reproduction of linear fields (sum S_i x_i = x, sum dS_i x_i = 1) for linear, quadratic and
+ * cubic B-splines, the cubic ones with their boundary-modified edge cells (shape.h).
  */
 #include "../harness.h"
 #include "shape.h"
@@ -13,11 +15,11 @@ static void check_kind(enum case_shape kind, const char *label)
 	const idx_t cells = 7;
 	const double h = 0.0371, inv_h = 1.0 / h;
 	const int S = shape_support(kind);
-	double worst_sum = 0, worst_grad = 0, worst_fd = 0, min_w = 1;
+	double worst_sum = 0, worst_grad = 0, worst_fd = 0, min_w = 1, worst_lin = 0, worst_dlin = 0;
 	int out_of_range = 0;
 	for (int k = 0; k < SAMPLES; k++) {
-		/* one in four samples inside the first or last cell, where the edge pieces live */
-		double xi = k % 4 == 0 ? rnd(0, 1) : k % 4 == 1 ? rnd(cells - 1, cells) : rnd(0, cells);
+		/* half the samples inside the two cells next to either edge, where the edge pieces live */
+		double xi = k % 4 == 0 ? rnd(0, 2) : k % 4 == 1 ? rnd(cells - 2, cells) : rnd(0, cells);
 		idx_t i0;
 		double w[SHAPE_SUPPORT_MAX], dw[SHAPE_SUPPORT_MAX];
 		shape_1d(kind, xi, cells, inv_h, &i0, w, dw);
@@ -30,9 +32,15 @@ static void check_kind(enum case_shape kind, const char *label)
 		}
 		worst_sum = fmax(worst_sum, fabs(sum - 1));
 		worst_grad = fmax(worst_grad, fabs(gsum) * h);
+		/* linear field u = x (in cells): sum S_a (i0 + a) = xi, sum dS_a (i0 + a) = 1 / h */
+		double lin = 0, dlin = 0;
+		for (int a = 0; a < S; a++)
+			lin += w[a] * (double)(i0 + a), dlin += dw[a] * (double)(i0 + a);
+		worst_lin = fmax(worst_lin, fabs(lin - xi) / cells);
+		worst_dlin = fmax(worst_dlin, fabs(dlin * h - 1));
 		/* finite difference of node i0+a's weight in x (in metres) */
 		const double eps = 1e-6;
-		double half = 2 * xi;   /* pieces join at integers (linear) and half-integers (quadratic) */
+		double half = 2 * xi;   /* pieces join at integers (linear, cubic) and half-integers (quadratic) */
 		if (xi > eps && xi < cells - eps && fabs(half - round(half)) > 1e-4) {
 			for (int a = 0; a < S; a++) {
 				double wp[SHAPE_SUPPORT_MAX], wm[SHAPE_SUPPORT_MAX], d[SHAPE_SUPPORT_MAX];
@@ -48,14 +56,17 @@ static void check_kind(enum case_shape kind, const char *label)
 		}
 	}
 	char name[96];
-	printf("INFO %s: max |sum S - 1| = %.2e, max |sum dS| h = %.2e, max FD gradient error %.2e, min S %.2e\n",
-	       label, worst_sum, worst_grad, worst_fd, min_w);
+	printf("INFO %s: max |sum S - 1| = %.2e, max |sum dS| h = %.2e, max FD gradient error %.2e, min S %.2e, "
+	       "linear field error %.2e (value / cells), %.2e (gradient h)\n",
+	       label, worst_sum, worst_grad, worst_fd, min_w, worst_lin, worst_dlin);
 	snprintf(name, sizeof name, "%s_partition_of_unity", label);
 	CHECK(worst_sum < 1e-14, name, "max |sum - 1| = %.3e", worst_sum);
 	snprintf(name, sizeof name, "%s_gradient_sum_zero", label);
 	CHECK(worst_grad < 1e-13, name, "max |sum dS| h = %.3e", worst_grad);
 	snprintf(name, sizeof name, "%s_gradient_matches_finite_difference", label);
 	CHECK(worst_fd < 1e-6, name, "max error %.3e", worst_fd);
+	snprintf(name, sizeof name, "%s_reproduces_linear_fields", label);
+	CHECK(worst_lin < 1e-14 && worst_dlin < 1e-13, name, "value error %.3e, gradient error %.3e", worst_lin, worst_dlin);
 	snprintf(name, sizeof name, "%s_non_negative", label);
 	CHECK(min_w >= 0, name, "min weight %.3e", min_w);
 	snprintf(name, sizeof name, "%s_support_inside_grid", label);
@@ -110,11 +121,46 @@ static void check_2d(enum case_shape kind, const char *label)
 	particles_release(&p);
 }
 
+/* Cubic B-splines: away from the edges the weights are the uniform cubic B-spline's, and the
+ * boundary-modified edge functions take the closed forms of shape.h: at s in the edge cell,
+ * S_0 = N(s) + 2 (1 - s)^3 / 6 and S_1 = 2/3 - t^2 + t^3 / 3 with t = 1 - s (mirrored at the top);
+ * with only 3 cells (the fewest the case loader allows) both edge treatments act in one support. */
+static void check_cubic_closed_form(void)
+{
+	const double inv_h = 1.0 / 0.0271;
+	double worst = 0;
+	for (idx_t cells = 3; cells <= 9; cells += 6)
+		for (int k = 0; k < 2000; k++) {
+			double xi = rnd(0, (double)cells), w[SHAPE_SUPPORT_MAX], dw[SHAPE_SUPPORT_MAX];
+			idx_t i0;
+			shape_1d(SHAPE_CUBIC_BSPLINE, xi, cells, inv_h, &i0, w, dw);
+			for (int a = 0; a < 4; a++) {
+				double node = (double)(i0 + a), d = fabs(xi - node), ref;
+				ref = d < 1 ? 2.0 / 3 - d * d + d * d * d / 2 : d < 2 ? (2 - d) * (2 - d) * (2 - d) / 6 : 0;
+				double s0 = xi, s1 = cells - xi;   /* distances to the edges, cells */
+				if (i0 + a == 0 && s0 < 1)
+					ref += (1 - s0) * (1 - s0) * (1 - s0) / 3;
+				if (i0 + a == 1 && s0 < 1)
+					ref = 2.0 / 3 - (1 - s0) * (1 - s0) + (1 - s0) * (1 - s0) * (1 - s0) / 3;
+				if (i0 + a == cells && s1 < 1)
+					ref += (1 - s1) * (1 - s1) * (1 - s1) / 3;
+				if (i0 + a == cells - 1 && s1 < 1)
+					ref = 2.0 / 3 - (1 - s1) * (1 - s1) + (1 - s1) * (1 - s1) * (1 - s1) / 3;
+				worst = fmax(worst, fabs(w[a] - ref));
+			}
+		}
+	printf("INFO cubic_bspline: max difference from the closed-form weights %.2e\n", worst);
+	CHECK(worst < 1e-14, "cubic_bspline_matches_closed_form", "max difference %.3e", worst);
+}
+
 int main(void)
 {
 	check_kind(SHAPE_LINEAR, "linear");
 	check_kind(SHAPE_QUADRATIC_BSPLINE, "quadratic_bspline");
+	check_kind(SHAPE_CUBIC_BSPLINE, "cubic_bspline");
+	check_cubic_closed_form();
 	check_2d(SHAPE_LINEAR, "linear");
 	check_2d(SHAPE_QUADRATIC_BSPLINE, "quadratic_bspline");
+	check_2d(SHAPE_CUBIC_BSPLINE, "cubic_bspline");
 	HARNESS_EXIT();
 }

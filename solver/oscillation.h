@@ -1,0 +1,32 @@
+/*
+ * oscillation.h - the oscillation index of the soil's mean effective stress: a measure of the
+ * point-to-point stress noise that volumetric locking leaves (000 §4.4.2, App. A, Fig. 12), for
+ * tests and reports.
+ *
+ * Definition (docs/numerics.md). Points are neighbours when their reference positions x0 are one
+ * seeding spacing apart along x or along y (the lattice sim.c seeds). With p'_i =
+ * (sigma'_xx + sigma'_yy + sigma'_zz) / 3, each point i that has both neighbours a, b along a
+ * direction contributes its overshoot
+ *     e = max(0, p'_i - max(p'_a, p'_b), min(p'_a, p'_b) - p'_i),
+ * the amount by which it sticks out of its neighbours' range, and
+ *     index = sqrt(mean e^2) / sqrt(mean_i p'_i^2).
+ * A field that is monotone along every lattice line scores 0 however coarse: smooth fields and the
+ * piecewise-constant fields of patch averaging (Eq. 83) alike, apart from their true extrema
+ * (O(h^2)). A checkerboard of amplitude A on a mean P scores about 2 A / P. The index measures
+ * noise, not resolution.
+ */
+#ifndef PORO_OSCILLATION_H
+#define PORO_OSCILLATION_H
+
+#include "case.h"
+#include "particles.h"
+
+/* Computes the index of the soil set p, seeded on the grid g at `spacing` metres (cell_size /
+ * particles_per_cell), into *index. Points that share a lattice site with an earlier point are
+ * left out. Allocates and frees its own work space (it is a report, not part of a step).
+ * Returns PORO_OK; PORO_ENOMEM; PORO_EINVAL for a non-positive spacing, when no point has two
+ * neighbours along a line, or when the mean effective stress is zero everywhere (*index is then 0). */
+enum poro_status oscillation_index(const struct case_grid *g, const struct particles *p, double spacing,
+				   double *index, struct poro_error *err);
+
+#endif
