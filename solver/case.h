@@ -179,6 +179,8 @@ struct case_spec {
 	struct {
 		double acceleration[2];   /* body force b, m/s^2, e.g. [0, -9.81] */
 		double ramp_time;         /* s; 0 = applied at once */
+		int elastic_loading;      /* 000 App. B.4: plastic models stay elastic during the ramp, and at
+					     its end every soil point's state becomes its reference */
 	} gravity;
 	struct case_boundary boundaries[FACE_COUNT];
 	int load_count;

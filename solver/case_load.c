@@ -81,7 +81,7 @@ static const char *const body_keys[] = { "name", "material", "rectangle", "polyg
 					 "porosity", "hydraulic_conductivity", "permeability_law", NULL };
 static const char *const box_keys[] = { "min", "max", NULL };
 static const char *const fluid_keys[] = { "density", "bulk_modulus", NULL };
-static const char *const gravity_keys[] = { "acceleration", "ramp_time", NULL };
+static const char *const gravity_keys[] = { "acceleration", "ramp_time", "elastic_loading", NULL };
 static const char *const face_boundary_keys[] = { "soil", "water", "drainage", NULL };
 static const char *const load_keys[] = { "body", "face", "from", "to", "traction", "time_function", NULL };
 static const char *const time_keys[] = { "dt", "end", NULL };
@@ -447,6 +447,10 @@ static void read_gravity(struct case_reader *r, const json_t *root, struct case_
 	case_check_keys(r, o, "/gravity", gravity_keys);
 	case_read_vec2(r, o, "/gravity", "acceleration", CASE_OPTIONAL, NULL, c->gravity.acceleration);
 	case_read_number(r, o, "/gravity", "ramp_time", CASE_OPTIONAL, &NON_NEGATIVE, &c->gravity.ramp_time);
+	case_read_bool(r, o, "/gravity", "elastic_loading", CASE_OPTIONAL, &c->gravity.elastic_loading);
+	if (c->gravity.elastic_loading && !(c->gravity.ramp_time > 0))
+		case_problem(r, "/gravity/elastic_loading", "needs a gravity ramp_time > 0: the elastic loading lasts "
+			     "as long as the ramp");
 }
 
 static void read_boundaries(struct case_reader *r, const json_t *root, struct case_boundary *faces)

@@ -85,6 +85,8 @@ struct stress_update {
 	double *plastic_strain;  /* [1] accumulated plastic strain (plastic models: the deviatoric
 				    plastic strain, principal_return.h) */
 	double *tangent;         /* [16] out: consistent tangent (layout above), Pa; NULL when not wanted */
+	int elastic_only;        /* 1: plastic models accept the elastic trial state (the elastic
+				    gravity loading of 000 App. B.4); 0 for a normal update */
 };
 
 void material_init(struct material *m, const struct case_material *spec);

@@ -448,7 +448,7 @@ enum poro_status nor_sand_update(const struct material *m, struct stress_update 
 	if (!isfinite(F_tr))
 		return poro_error_set(err, PORO_ESOLVER, "nor-sand: trial state not finite (p %.3g Pa, image "
 				      "pressure %.3g Pa)", p_tr, c.pi_n);
-	if (F_tr <= NS_YIELD_TOLERANCE * (p_tr + q_tr)) {
+	if (u->elastic_only || F_tr <= NS_YIELD_TOLERANCE * (p_tr + q_tr)) {
 		for (int a = 0; a < 3; a++)
 			s[a] = -p_tr + 2.0 * G * dev[a];
 		elastic_Ds(p_tr / n->kappa, G, Ds);

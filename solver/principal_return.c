@@ -302,7 +302,7 @@ enum poro_status principal_return_map(const struct material *m, plastic_law_fn l
 	law(m, pr->eps_d, &lw);
 	double scale = fabs(pr->s[0]) + fabs(pr->s[2]) + 2.0 * lw.c * m->cos_phi;
 	pr->iterations = 0;
-	if (principal_yield(m, pr->s, lw.c) <= YIELD_TOLERANCE * scale) {
+	if (pr->elastic_only || principal_yield(m, pr->s, lw.c) <= YIELD_TOLERANCE * scale) {
 		pr->regime = RETURN_ELASTIC;
 		if (want_tangent)
 			elastic_matrix(m, pr->D);

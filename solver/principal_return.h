@@ -57,6 +57,7 @@ struct principal_return {
 				    elastic strains in the same order, Pa */
 	enum principal_regime regime;   /* out: which return was taken */
 	int iterations;          /* out: Newton iterations after the first solve */
+	int elastic_only;        /* in: 1 accepts the trial state as it is (RETURN_ELASTIC, elastic D) */
 };
 
 /* Returns the trial state pr->s of the material m with hardening law `law` onto its yield

@@ -145,7 +145,7 @@ enum poro_status principal_update(const struct material *m, plastic_law_fn law, 
 		return PORO_ESOLVER;
 	int pos[3];
 	sort_slots(t.st, pos);
-	struct principal_return pr = { .eps_d = u->state[STATE_DEVIATORIC_PLASTIC_STRAIN] };
+	struct principal_return pr = { .eps_d = u->state[STATE_DEVIATORIC_PLASTIC_STRAIN], .elastic_only = u->elastic_only };
 	for (int a = 0; a < 3; a++)
 		pr.s[pos[a]] = t.st[a];
 	enum poro_status st = principal_return_map(m, law, &pr, u->tangent != NULL, err);

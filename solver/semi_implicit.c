@@ -472,21 +472,42 @@ static enum poro_status update_soil_kinematics(struct sim *s)
 	return PORO_OK;
 }
 
+/* 000 App. B.4 with gravity.elastic_loading: a step that ends within the gravity ramp is elastic
+ * (1); the first step after it (2) first makes each point's present state, the one at the end of
+ * the ramp, its reference (material_reset_reference: p0, eps_v0^e, the image pressure from OCR). */
+static int gravity_loading_stage(const struct sim *s)
+{
+	const double ramp = s->spec->gravity.ramp_time, tol = 1e-9 * s->dt;
+	if (!s->spec->gravity.elastic_loading)
+		return 0;
+	if (s->time + s->dt <= ramp + tol)
+		return 1;
+	return s->time <= ramp + tol ? 2 : 0;
+}
+
 /* Step 10: stress update through the material interface (Eqs. 69-76). */
 static enum poro_status update_stress(struct sim *s)
 {
 	struct particles *p = &s->soil;
 	enum poro_status status = PORO_OK;
+	const int stage = gravity_loading_stage(s);
 	for (idx_t q = 0; q < p->n && status == PORO_OK; q++) {
+		const struct material *m = &s->materials[s->spec->bodies[p->body[q]].material];
+		const double *dF = p->dF + 4 * q;
+		if (stage == 2) {   /* the volume is already this step's: J at the end of the ramp is J / dJ */
+			const double J_ramp = p->volume[q] / p->volume0[q] / (dF[0] * dF[3] - dF[1] * dF[2]);
+			material_reset_reference(m, p->stress + 4 * q, p->Be + 4 * q, J_ramp, p->state + STATE_MAX * q);
+			p->plastic_strain[q] = 0.0;
+		}
 		struct stress_update u = {
-			.dF = p->dF + 4 * q,
+			.dF = dF,
 			.J = p->volume[q] / p->volume0[q],
 			.stress = p->stress + 4 * q,
 			.Be = p->Be + 4 * q,
 			.state = p->state + STATE_MAX * q,
 			.plastic_strain = p->plastic_strain + q,
+			.elastic_only = stage == 1,
 		};
-		const struct material *m = &s->materials[s->spec->bodies[p->body[q]].material];
 		status = material_update(m, &u, &s->err);
 	}
 	return status;
