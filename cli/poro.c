@@ -73,6 +73,14 @@ static int report(const struct http_response *r)
 	return 1;
 }
 
+/* Reports a failed response, releases it and gives the exit status: `return fail(&r);`. */
+static int fail(struct http_response *r)
+{
+	int rc = report(r);
+	http_response_release(r);
+	return rc;
+}
+
 /* GET or POST with a few retries while the server cannot be reached; the request must be safe
  * to repeat (GET, or POST with an idempotency key). */
 static long call(const char *method, const char *path, const json_t *body, const char *header,
@@ -87,6 +95,14 @@ static long call(const char *method, const char *path, const json_t *body, const
 		sleep_s(wait);
 		wait *= 2;
 	}
+}
+
+/* GET /v1/jobs/{id}: the job, with its files and events. */
+static long get_job(long long id, struct http_response *r)
+{
+	char path[64];
+	snprintf(path, sizeof path, "/v1/jobs/%lld", id);
+	return call("GET", path, NULL, NULL, r);
 }
 
 static int parse_id(const char *s, long long *id)
@@ -153,17 +169,14 @@ static void draw_progress(long long id, const json_t *job, int tty, int *last_de
 
 static int wait_job(long long id)
 {
-	char path[64], last_state[32] = "";
+	char last_state[32] = "";
 	int tty = isatty(2), last_decile = -1;
-	snprintf(path, sizeof path, "/v1/jobs/%lld", id);
 	for (;;) {
 		struct http_response r;
-		if (call("GET", path, NULL, NULL, &r) != 200) {
+		if (get_job(id, &r) != 200) {
 			if (tty)
 				fputc('\n', stderr);
-			int rc = report(&r);
-			http_response_release(&r);
-			return rc;
+			return fail(&r);
 		}
 		const char *state = json_get_str(r.json, "state", "?");
 		if (tty || !terminal(state))   /* the final state gets its own line below */
@@ -275,11 +288,8 @@ static int cmd_ls(int argc, char **argv)
 	char path[512];
 	snprintf(path, sizeof path, "/v1/jobs?limit=%lld%s%s", limit, state ? "&state=" : "", state ? state : "");
 	struct http_response r;
-	if (call("GET", path, NULL, NULL, &r) != 200) {
-		int rc = report(&r);
-		http_response_release(&r);
-		return rc;
-	}
+	if (call("GET", path, NULL, NULL, &r) != 200)
+		return fail(&r);
 	printf("%-8s %-10s %-12s %-24s %4s %7s %8s  %s\n", "ID", "STATE", "USER", "NAME", "PRI", "ATTEMPT", "PROGRESS",
 	       "CREATED");
 	size_t i;
@@ -310,14 +320,10 @@ static int cmd_show(int argc, char **argv)
 	long long id;
 	if (argc != 1 || parse_id(argv[0], &id) < 0)
 		return usage();
-	char path[64], buf[256];
-	snprintf(path, sizeof path, "/v1/jobs/%lld", id);
+	char buf[256];
 	struct http_response r;
-	if (call("GET", path, NULL, NULL, &r) != 200) {
-		int rc = report(&r);
-		http_response_release(&r);
-		return rc;
-	}
+	if (get_job(id, &r) != 200)
+		return fail(&r);
 	const json_t *j = r.json;
 	snprintf(buf, sizeof buf, "%lld", json_get_int(j, "id", -1));
 	show_field("id", buf);
@@ -379,14 +385,9 @@ static int print_line(const char *line, size_t len, void *user)
 /* Fetches the job's state and attempt; 0, or 1 after reporting an error. */
 static int job_state(long long id, char *state, size_t size, long long *attempt)
 {
-	char path[64];
-	snprintf(path, sizeof path, "/v1/jobs/%lld", id);
 	struct http_response r;
-	if (call("GET", path, NULL, NULL, &r) != 200) {
-		int rc = report(&r);
-		http_response_release(&r);
-		return rc;
-	}
+	if (get_job(id, &r) != 200)
+		return fail(&r);
 	snprintf(state, size, "%s", json_get_str(r.json, "state", "?"));
 	*attempt = json_get_int(r.json, "attempt", 0);
 	http_response_release(&r);
@@ -419,11 +420,8 @@ static int follow_log(long long id)
 		long long got = 0;
 		long status = http_stream_lines(http, path, print_line, NULL, &got, &r);
 		offset += got;
-		if (status != 0 && !http_ok(&r)) {
-			int rc = report(&r);
-			http_response_release(&r);
-			return rc;
-		}
+		if (status != 0 && !http_ok(&r))
+			return fail(&r);
 		http_response_release(&r);
 		if (job_state(id, state, sizeof state, &attempt))
 			return 1;
@@ -465,11 +463,8 @@ static int cmd_cancel(int argc, char **argv)
 	char path[64];
 	snprintf(path, sizeof path, "/v1/jobs/%lld/cancel", id);
 	struct http_response r;
-	if (call("POST", path, NULL, NULL, &r) != 200) {
-		int rc = report(&r);
-		http_response_release(&r);
-		return rc;
-	}
+	if (call("POST", path, NULL, NULL, &r) != 200)
+		return fail(&r);
 	const char *state = json_get_str(r.json, "state", "?");
 	if (!strcmp(state, "cancelled"))
 		printf("job %lld cancelled\n", id);
@@ -510,11 +505,8 @@ static int fetch_file(long long id, const json_t *job, const char *name, const c
 	struct http_response r;
 	long long size = 0;
 	http_download(http, path, part, sha, &size, &r);
-	if (!http_ok(&r)) {
-		int rc = report(&r);
-		http_response_release(&r);
-		return rc;
-	}
+	if (!http_ok(&r))
+		return fail(&r);
 	http_response_release(&r);
 	if (!digest_hex_equal(sha, want)) {
 		remove(part);
@@ -546,14 +538,9 @@ static int cmd_fetch(int argc, char **argv)
 		fprintf(stderr, "poro: cannot create '%s': %s\n", dir, strerror(errno));
 		return 1;
 	}
-	char path[64];
-	snprintf(path, sizeof path, "/v1/jobs/%lld", id);
 	struct http_response r;
-	if (call("GET", path, NULL, NULL, &r) != 200) {
-		int rc = report(&r);
-		http_response_release(&r);
-		return rc;
-	}
+	if (get_job(id, &r) != 200)
+		return fail(&r);
 	int rc = fetch_file(id, r.json, "result.h5", dir);
 	rc |= fetch_file(id, r.json, "result.xdmf", dir);
 	http_response_release(&r);

@@ -9,6 +9,11 @@
 #                                         PYTHON run with c (the case) and m (the material)
 #   expect_invalid NAME POINTER [FILE]    `poro-solve validate` of FILE ($tmp/NAME.json) exits 2 and
 #                                         names POINTER; the check is called validate_NAME_...
+#   derive_element NAME BASE PYTHON       $tmp/NAME.json: the element case BASE after the python
+#                                         statement PYTHON run with c (the element case)
+#   expect_element_refused NAME FILE POINTER...
+#                                         `poro-solve element FILE` exits 2, names every POINTER and
+#                                         writes no element.csv
 
 check() {
 	if [ "$2" -eq 0 ]; then echo "PASS $1"; else echo "FAIL $1: $3"; fi
@@ -36,4 +41,24 @@ expect_invalid() {
 	grep -q "^$2: " "$tmp/err"
 	check "validate_$1_exits_2_naming_pointer" $(( rc != 2 || $? != 0 )) \
 		"exit $rc, wanted 2 and '$2: ...' in: $(head -c 300 "$tmp/err")"
+}
+
+derive_element() {
+	python3 - "$2" "$tmp/$1.json" "$3" <<'EOF2'
+import json, sys
+c = json.load(open(sys.argv[1]))
+exec(sys.argv[3])
+json.dump(c, open(sys.argv[2], "w"))
+EOF2
+}
+
+expect_element_refused() {
+	local name=$1 file=$2 rc ok=0 pointer
+	shift 2
+	"$solve" element "$file" --out "$tmp/$name.out" > /dev/null 2> "$tmp/err"
+	rc=$?
+	[ "$rc" -eq 2 ] || ok=1
+	for pointer in "$@"; do grep -q "^$pointer: " "$tmp/err" || ok=1; done
+	[ -e "$tmp/$name.out/element.csv" ] && ok=1
+	check "${name}_exits_2_listing_every_problem" $ok "exit $rc, stderr: $(head -c 300 "$tmp/err")"
 }

@@ -63,16 +63,8 @@ bad nor_sand_key_on_mohr_coulomb /materials/0/shear_modulus
 
 # ---- an invalid Nor-Sand element case: validate and element both exit 2 naming the pointer ------
 
-python3 - tests/cases/norsand_undrained_p100.json "$tmp/element_bad.json" <<'EOF2'
-import json, sys
-c = json.load(open(sys.argv[1]))
-c["material"]["yield_function_constant"] = 1.0
-del c["material"]["shear_modulus"]
-json.dump(c, open(sys.argv[2], "w"))
-EOF2
+derive_element element_bad tests/cases/norsand_undrained_p100.json \
+	'c["material"]["yield_function_constant"] = 1.0; del c["material"]["shear_modulus"]'
 bad element_N_one /material/yield_function_constant "$tmp/element_bad.json"
-"$solve" element "$tmp/element_bad.json" --out "$tmp/element_bad" > /dev/null 2> "$tmp/err"
-rc=$?
-grep -q "^/material/yield_function_constant: " "$tmp/err" && grep -q "^/material/shear_modulus: " "$tmp/err"
-check element_nor_sand_invalid_case_exits_2_listing_every_problem $(( rc != 2 || $? != 0 )) \
-	"exit $rc, stderr: $(head -c 300 "$tmp/err")"
+expect_element_refused element_nor_sand_invalid_case "$tmp/element_bad.json" /material/yield_function_constant \
+	/material/shear_modulus
