@@ -14,6 +14,7 @@
 
 #include "../harness.h"
 #include "material.h"
+#include "principal_values.h"
 #include "principal_return.h"
 
 #define FD_STEP 1e-8             /* central-difference step on a strain component (strains ~1e-3) */
@@ -98,19 +99,6 @@ static void random_trial(double vlo, double vhi, double dev, double eps[4])
 	eps[1] = v / 3 + rnd(-dev, dev);
 	eps[2] = rnd(-dev, dev);
 	eps[3] = v / 3 + rnd(-dev, dev);
-}
-
-/* Principal values of a (xx, yy, xy, zz) tensor, sorted descending. */
-static void sorted_principal(const double t[4], double s[3])
-{
-	double l[2], th;
-	sym2_eigen(t[0], t[1], t[2], l, &th);
-	s[0] = l[0], s[1] = l[1], s[2] = t[3];
-	for (int a = 0; a < 3; a++)
-		for (int b = a + 1; b < 3; b++)
-			if (s[b] > s[a]) {
-				double x = s[a]; s[a] = s[b]; s[b] = x;
-			}
 }
 
 /* Largest |Phi| / scale over plastic trial states from random_trial(vlo, vhi, dev), with the

@@ -20,6 +20,7 @@
 #include "../harness.h"
 #include "element.h"
 #include "material.h"
+#include "principal_values.h"
 
 #define FD_STEP 1e-8
 #define TANGENT_TOLERANCE 1e-6
@@ -199,18 +200,6 @@ static enum poro_status step_from(const struct material *m, const struct start *
 	enum poro_status s = material_update(m, &u, &err);
 	u.dF = dF, u.dF_zz = dF_zz, u.J = (dF[0] * dF[3] - dF[1] * dF[2]) * dF_zz;
 	return s ? s : material_update(m, &u, &err);
-}
-
-static void sorted_principal(const double t[4], double s[3])
-{
-	double l[2], th;
-	sym2_eigen(t[0], t[1], t[2], l, &th);
-	s[0] = l[0], s[1] = l[1], s[2] = t[3];
-	for (int a = 0; a < 3; a++)
-		for (int b = a + 1; b < 3; b++)
-			if (s[b] > s[a]) {
-				double x = s[a]; s[a] = s[b]; s[b] = x;
-			}
 }
 
 static void check_objectivity(const struct material *m)
