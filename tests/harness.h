@@ -8,10 +8,12 @@
 #ifndef PORO_TEST_HARNESS_H
 #define PORO_TEST_HARNESS_H
 
+#include <dirent.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 static int harness_failed_count;
 
@@ -80,5 +82,39 @@ static inline char *harness_read_file(const char *path)
 }
 
 #define HARNESS_EXIT() return harness_failed_count ? 1 : 0
+
+/* A fresh directory /tmp/PREFIX.XXXXXX for a test's files; NULL when none could be made. The
+ * names live as long as the program (up to HARNESS_DIRS_MAX of them). */
+#define HARNESS_DIRS_MAX 16
+static inline char *harness_temp_dir(const char *prefix)
+{
+	static char dirs[HARNESS_DIRS_MAX][96];
+	static int used;
+	if (used == HARNESS_DIRS_MAX)
+		return NULL;
+	snprintf(dirs[used], sizeof dirs[used], "/tmp/%.60s.XXXXXX", prefix);
+	return mkdtemp(dirs[used]) ? dirs[used++] : NULL;
+}
+
+/* dir/name into buf; returns buf. */
+static inline char *harness_join(char *buf, size_t size, const char *dir, const char *name)
+{
+	snprintf(buf, size, "%s/%s", dir, name);
+	return buf;
+}
+
+/* Removes the files directly in dir, then dir (test directories hold no subdirectories). */
+static inline void harness_remove_dir(const char *dir)
+{
+	DIR *d = opendir(dir);
+	struct dirent *e;
+	char path[512];
+	while (d && (e = readdir(d)))
+		if (strcmp(e->d_name, ".") && strcmp(e->d_name, ".."))
+			unlink(harness_join(path, sizeof path, dir, e->d_name));
+	if (d)
+		closedir(d);
+	rmdir(dir);
+}
 
 #endif

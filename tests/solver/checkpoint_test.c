@@ -70,34 +70,6 @@ static char *case_json(const char *phases, const char *extra)
 
 /* ---- fixtures ---------------------------------------------------------------------------------- */
 
-static char *make_dir(void)
-{
-	static char dirs[8][64];
-	static int used;
-	if (used == 8)
-		return NULL;
-	snprintf(dirs[used], sizeof dirs[used], "/tmp/checkpoint_test.XXXXXX");
-	return mkdtemp(dirs[used]) ? dirs[used++] : NULL;
-}
-
-static void remove_dir(const char *dir)
-{
-	const char *files[] = {"result.h5", "result.xdmf", ".result.xdmf.tmp", CHECKPOINT_NAME,
-			       CHECKPOINT_TMP_NAME, "truncated.h5", "garbage.h5", "damaged.h5"};
-	char path[128];
-	for (size_t k = 0; k < sizeof files / sizeof files[0]; k++) {
-		snprintf(path, sizeof path, "%.63s/%s", dir, files[k]);
-		unlink(path);
-	}
-	rmdir(dir);
-}
-
-static char *join(char *buf, size_t size, const char *dir, const char *name)
-{
-	snprintf(buf, size, "%s/%s", dir, name);
-	return buf;
-}
-
 static struct sim *new_sim(const char *json, struct case_spec **c)
 {
 	struct poro_error err = {0};
@@ -193,7 +165,7 @@ static void test_resume(const char *phases)
 	char name[128], path[128];
 	struct case_spec *ca = NULL, *cb = NULL;
 	const char *json = case_json(phases, "");
-	char *dir = make_dir();
+	char *dir = harness_temp_dir("checkpoint_test");
 	struct sim *a = new_sim(json, &ca), *b = new_sim(json, &cb);
 	snprintf(name, sizeof name, "%s_builds", phases);
 	CHECK(dir && a && b, name, "no directory or simulation");
@@ -203,11 +175,11 @@ static void test_resume(const char *phases)
 	int ok = steps(a, STEPS_BEFORE) == 0 && checkpoint_write(a, dir) == PORO_OK;
 	snprintf(name, sizeof name, "%s_checkpoint_written", phases);
 	struct stat sb;
-	CHECK(ok && stat(join(path, sizeof path, dir, CHECKPOINT_NAME), &sb) == 0 &&
-	      stat(join(path, sizeof path, dir, CHECKPOINT_TMP_NAME), &sb) != 0, name, "%s",
+	CHECK(ok && stat(harness_join(path, sizeof path, dir, CHECKPOINT_NAME), &sb) == 0 &&
+	      stat(harness_join(path, sizeof path, dir, CHECKPOINT_TMP_NAME), &sb) != 0, name, "%s",
 	      ok ? "checkpoint.h5 missing or checkpoint.h5.tmp left" : sim_error(a)->message);
 
-	enum poro_status st = checkpoint_load(b, join(path, sizeof path, dir, CHECKPOINT_NAME));
+	enum poro_status st = checkpoint_load(b, harness_join(path, sizeof path, dir, CHECKPOINT_NAME));
 	snprintf(name, sizeof name, "%s_load_restores_exact_state", phases);
 	CHECK(!st && checkpoint_resumed(b) && identical(a, b), name, "status %d: %s", st, sim_error(b)->message);
 
@@ -229,7 +201,7 @@ out:
 	case_destroy(&ca);
 	case_destroy(&cb);
 	if (dir)
-		remove_dir(dir);
+		harness_remove_dir(dir);
 }
 
 /* ---- refusals ---------------------------------------------------------------------------------- */
@@ -291,13 +263,13 @@ static void test_refusals(void)
 	char path[128], other[128], message[PORO_ERROR_MESSAGE_MAX];
 	const char *json = case_json("double_point", "");
 	struct case_spec *c = NULL;
-	char *dir = make_dir();
+	char *dir = harness_temp_dir("checkpoint_test");
 	struct sim *s = new_sim(json, &c);
 	int ok = dir && s && steps(s, 3) == 0 && checkpoint_write(s, dir) == PORO_OK;
 	CHECK(ok, "refusal_fixture", "cannot write a checkpoint: %s", s ? sim_error(s)->message : "no sim");
 	if (!ok)
 		goto out;
-	join(path, sizeof path, dir, CHECKPOINT_NAME);
+	harness_join(path, sizeof path, dir, CHECKPOINT_NAME);
 
 	/* another case: one value changed */
 	char changed[4096];
@@ -320,13 +292,13 @@ static void test_refusals(void)
 	/* truncated at half its length */
 	struct stat sb;
 	stat(path, &sb);
-	join(other, sizeof other, dir, "truncated.h5");
+	harness_join(other, sizeof other, dir, "truncated.h5");
 	copy_prefix(path, other, (long)sb.st_size / 2);
 	st = try_load(json, other, message, sizeof message);
 	CHECK(st == PORO_EIO && strstr(message, other), "truncated_checkpoint_refused", "status %d: %s", st, message);
 
 	/* not HDF5 at all */
-	join(other, sizeof other, dir, "garbage.h5");
+	harness_join(other, sizeof other, dir, "garbage.h5");
 	FILE *f = fopen(other, "wb");
 	for (int i = 0; f && i < 4096; i++)
 		fputc((int)rnd(0, 256), f);
@@ -336,12 +308,12 @@ static void test_refusals(void)
 	CHECK(st == PORO_EIO && strstr(message, other), "garbage_checkpoint_refused", "status %d: %s", st, message);
 
 	/* a missing file */
-	join(other, sizeof other, dir, "no_such_checkpoint.h5");
+	harness_join(other, sizeof other, dir, "no_such_checkpoint.h5");
 	st = try_load(json, other, message, sizeof message);
 	CHECK(st == PORO_EIO && strstr(message, other), "missing_checkpoint_refused", "status %d: %s", st, message);
 
 	/* a damaged index: a body no case has */
-	join(other, sizeof other, dir, "damaged.h5");
+	harness_join(other, sizeof other, dir, "damaged.h5");
 	copy_prefix(path, other, (long)sb.st_size);
 	ok = damage_body(other) == 0;
 	st = try_load(json, other, message, sizeof message);
@@ -350,7 +322,7 @@ static void test_refusals(void)
 
 	/* a result file is not a checkpoint */
 	if (sim_run(s, dir, "checkpoint_test", NULL, NULL, NULL) == PORO_OK) {
-		join(other, sizeof other, dir, "result.h5");
+		harness_join(other, sizeof other, dir, "result.h5");
 		st = try_load(json, other, message, sizeof message);
 		CHECK(st == PORO_EINVAL && strstr(message, "not a checkpoint"), "result_file_refused", "status %d: %s",
 		      st, message);
@@ -359,7 +331,7 @@ out:
 	sim_destroy(&s);
 	case_destroy(&c);
 	if (dir)
-		remove_dir(dir);
+		harness_remove_dir(dir);
 }
 
 /* ---- sim_run: killed after a checkpoint, resumed into the same directory ----------------------- */
@@ -397,8 +369,8 @@ static void compare_results(const char *ref_dir, const char *dir, const char *ph
 	char name[128], ref_path[128], path[128];
 	struct results *ra = NULL, *rb = NULL;
 	struct poro_error err = {0};
-	results_open(&ra, join(ref_path, sizeof ref_path, ref_dir, "result.h5"), &err);
-	results_open(&rb, join(path, sizeof path, dir, "result.h5"), &err);
+	results_open(&ra, harness_join(ref_path, sizeof ref_path, ref_dir, "result.h5"), &err);
+	results_open(&rb, harness_join(path, sizeof path, dir, "result.h5"), &err);
 	long fa = ra ? results_frame_count(ra) : -1, fb = rb ? results_frame_count(rb) : -2;
 	int same_times = fa == fb && fa > 0;
 	for (long k = 0; same_times && k < fa; k++) {
@@ -461,7 +433,7 @@ static void test_run_killed_and_resumed(const char *phases)
 	char name[128], path[128];
 	/* checkpoints every 0.0011 s: at steps 11, 22 and 33; the child dies after the first */
 	const char *json = case_json(phases, CHECKPOINT_MEMBER);
-	char *ref_dir = make_dir(), *dir = make_dir();
+	char *ref_dir = harness_temp_dir("checkpoint_test"), *dir = harness_temp_dir("checkpoint_test");
 	struct case_spec *c = NULL;
 	struct sim *s = new_sim(json, &c);
 	int ok = ref_dir && dir && s && sim_run(s, ref_dir, "checkpoint_test", NULL, NULL, NULL) == PORO_OK;
@@ -485,7 +457,7 @@ static void test_run_killed_and_resumed(const char *phases)
 	CHECK(WIFEXITED(status) && WEXITSTATUS(status) == 0, name, "child status %d", status);
 
 	s = new_sim(json, &c);
-	enum poro_status st = s ? checkpoint_load(s, join(path, sizeof path, dir, CHECKPOINT_NAME)) : PORO_ENOMEM;
+	enum poro_status st = s ? checkpoint_load(s, harness_join(path, sizeof path, dir, CHECKPOINT_NAME)) : PORO_ENOMEM;
 	long resumed_at = s ? sim_steps_taken(s) : -1;
 	if (!st)
 		st = sim_run(s, dir, "checkpoint_test", NULL, NULL, NULL);
@@ -498,9 +470,9 @@ out:
 	sim_destroy(&s);
 	case_destroy(&c);
 	if (ref_dir)
-		remove_dir(ref_dir);
+		harness_remove_dir(ref_dir);
 	if (dir)
-		remove_dir(dir);
+		harness_remove_dir(dir);
 }
 
 /* The child of test_run_killed_and_resumed: runs the case into dir until its first checkpoint. */

@@ -51,28 +51,17 @@ static char *make_dir(void)
 	return d;
 }
 
-static void remove_dir(const char *dir)
-{
-	const char *files[] = {"result.h5", "result.xdmf", ".result.xdmf.tmp", "plain"};
-	char path[128];
-	for (size_t k = 0; k < sizeof files / sizeof files[0]; k++) {
-		snprintf(path, sizeof path, "%.63s/%s", dir, files[k]);
-		unlink(path);
-	}
-	rmdir(dir);
-}
-
 /* Removes the directory make_dir() returned last, at once. */
 static void drop_last_dir(void)
 {
 	if (dirs_used > 0)
-		remove_dir(dirs[--dirs_used]);
+		harness_remove_dir(dirs[--dirs_used]);
 }
 
 static void remove_dirs(void)
 {
 	for (int i = 0; i < dirs_used; i++)
-		remove_dir(dirs[i]);
+		harness_remove_dir(dirs[i]);
 }
 
 static void fill(double *a, size_t n, double lo, double hi)

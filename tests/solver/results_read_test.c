@@ -44,33 +44,6 @@ static const char case_format[] =
 
 /* ---- fixtures ---------------------------------------------------------------------------------- */
 
-static char *make_dir(void)
-{
-	static char dirs[4][64];
-	static int used;
-	if (used == 4)
-		return NULL;
-	snprintf(dirs[used], sizeof dirs[used], "/tmp/results_read_test.XXXXXX");
-	return mkdtemp(dirs[used]) ? dirs[used++] : NULL;
-}
-
-static void remove_dir(const char *dir)
-{
-	const char *files[] = {"result.h5", "result.xdmf", ".result.xdmf.tmp", "plain.h5", "stderr.txt"};
-	char path[128];
-	for (size_t k = 0; k < sizeof files / sizeof files[0]; k++) {
-		snprintf(path, sizeof path, "%.63s/%s", dir, files[k]);
-		unlink(path);
-	}
-	rmdir(dir);
-}
-
-static char *join(char *buf, size_t size, const char *dir, const char *name)
-{
-	snprintf(buf, size, "%s/%s", dir, name);
-	return buf;
-}
-
 static int spill(const char *path, const char *text)
 {
 	FILE *f = fopen(path, "wb");
@@ -228,7 +201,7 @@ static void check_run(const char *phases, const char *dir)
 	snprintf(name, sizeof name, "%s_run", phases);
 	CHECK(!st, name, "%s", err.message);
 	if (!st)
-		st = results_open(&r, join(path, sizeof path, dir, "result.h5"), &err);
+		st = results_open(&r, harness_join(path, sizeof path, dir, "result.h5"), &err);
 	snprintf(name, sizeof name, "%s_open", phases);
 	CHECK(!st && r, name, "%s", err.message);
 	if (!st) {
@@ -261,7 +234,7 @@ static void check_running_file(const char *dir)
 	int ok = !case_load_string(json, &c, &err) && !sim_create(&s, c, &err) &&
 		 !output_create(&o, dir, json, "results_read_test", 0, NULL, NULL, &err);
 	struct output_frame fr = {.time = 0.0, .step = 0, .soil = ok ? sim_soil(s) : NULL};
-	ok = ok && !output_frame_write(o, &fr, &err) && (one_frame = harness_read_file(join(xdmf, sizeof xdmf, dir, "result.xdmf")));
+	ok = ok && !output_frame_write(o, &fr, &err) && (one_frame = harness_read_file(harness_join(xdmf, sizeof xdmf, dir, "result.xdmf")));
 	fr.time = 1.7e-3, fr.step = 17;
 	ok = ok && !output_frame_write(o, &fr, &err);
 	output_destroy(&o);
@@ -270,7 +243,7 @@ static void check_running_file(const char *dir)
 	CHECK(ok, "running_file_prepared", "%s", err.message);
 
 	struct results *r = NULL;
-	join(path, sizeof path, dir, "result.h5");
+	harness_join(path, sizeof path, dir, "result.h5");
 	long listed_one = ok && !results_open(&r, path, &err) ? results_frame_count(r) : -1;
 	results_close(&r);
 	CHECK(listed_one == 1, "running_file_counts_frames_xdmf_lists", "%ld frames (%s)", listed_one, err.message);
@@ -297,7 +270,7 @@ static void capture_begin(struct capture *c, const char *dir)
 {
 	fflush(stderr);
 	c->saved = dup(2);
-	c->fd = open(join(c->path, sizeof c->path, dir, "stderr.txt"), O_CREAT | O_TRUNC | O_WRONLY, 0600);
+	c->fd = open(harness_join(c->path, sizeof c->path, dir, "stderr.txt"), O_CREAT | O_TRUNC | O_WRONLY, 0600);
 	dup2(c->fd, 2);
 }
 
@@ -319,11 +292,11 @@ static void check_open_errors(const char *dir)
 	struct results *r = NULL;
 	struct capture cap;
 	capture_begin(&cap, dir);
-	enum poro_status absent = results_open(&r, join(missing, sizeof missing, dir, "absent/result.h5"), &err);
+	enum poro_status absent = results_open(&r, harness_join(missing, sizeof missing, dir, "absent/result.h5"), &err);
 	int missing_ok = absent == PORO_EIO && r == NULL && strstr(err.message, missing) != NULL;
 	strcpy(missing_msg, err.message);
 	/* a file that exists but is no HDF5 file */
-	spill(join(plain, sizeof plain, dir, "plain.h5"), "{\"schema\": \"poro-case/1\"}\n");
+	spill(harness_join(plain, sizeof plain, dir, "plain.h5"), "{\"schema\": \"poro-case/1\"}\n");
 	enum poro_status st = results_open(&r, plain, &err);
 	long printed = capture_end(&cap);
 	CHECK(missing_ok, "missing_file_is_eio_naming_path", "status %d: %s", absent, missing_msg);
@@ -341,7 +314,7 @@ static void check_read_errors(const char *run_dir, const char *dir)
 	long rows = -1;
 	struct capture cap;
 	capture_begin(&cap, dir);
-	if (results_open(&r, join(path, sizeof path, run_dir, "result.h5"), &err)) {
+	if (results_open(&r, harness_join(path, sizeof path, run_dir, "result.h5"), &err)) {
 		capture_end(&cap);
 		CHECK(0, "read_errors_open", "%s", err.message);
 		return;
@@ -364,7 +337,7 @@ static void check_read_errors(const char *run_dir, const char *dir)
 
 int main(void)
 {
-	char *dp = make_dir(), *sp = make_dir(), *killed = make_dir(), *scratch = make_dir();
+	char *dp = harness_temp_dir("results_read_test"), *sp = harness_temp_dir("results_read_test"), *killed = harness_temp_dir("results_read_test"), *scratch = harness_temp_dir("results_read_test");
 	if (!dp || !sp || !killed || !scratch) {
 		CHECK(0, "temporary_directories", "mkdtemp failed");
 		HARNESS_EXIT();
@@ -375,10 +348,10 @@ int main(void)
 	check_running_file(killed);
 	check_read_errors(dp, scratch);
 	if (!harness_failed_count) {
-		remove_dir(dp);
-		remove_dir(sp);
-		remove_dir(killed);
-		remove_dir(scratch);
+		harness_remove_dir(dp);
+		harness_remove_dir(sp);
+		harness_remove_dir(killed);
+		harness_remove_dir(scratch);
 	}
 	HARNESS_EXIT();
 }
