@@ -51,5 +51,8 @@ int api_query_int(struct request *r, const char *name, long long min, long long 
 /* File names: ^[A-Za-z0-9][A-Za-z0-9._-]{0,127}$ and no "..". Decodes the raw path element into
  * out[129]; 0, or -1 after replying 400 invalid_file_name. */
 int api_file_name(struct request *r, const char *raw, char out[129]);
+/* The job {id} of the path exists and the caller may see it: 0, or -1 after replying (404 for
+ * another user's job, as for a missing one). */
+int api_job_visible(struct request *r);
 
 #endif

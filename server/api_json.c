@@ -4,6 +4,7 @@
  * pointer of a schema violation) and returns -1, so handlers read `if (check(...)) return;`.
  */
 #include "api.h"
+#include "store.h"
 
 #include <stdlib.h>
 #include <string.h>
@@ -135,5 +136,17 @@ int api_file_name(struct request *r, const char *raw, char out[FILE_NAME_MAX + 1
 			   "file name must match ^[A-Za-z0-9][A-Za-z0-9._-]{0,127}$ and not contain '..'");
 		return -1;
 	}
+	return 0;
+}
+
+int api_job_visible(struct request *r)
+{
+	json_t *job = NULL;
+	struct api_error err = { 0 };
+	if (store_job_get(r->srv->store, &r->who, r->id, 0, &job, &err) != API_OK) {
+		reply_error(r, &err);
+		return -1;
+	}
+	json_decref(job);
 	return 0;
 }

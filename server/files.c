@@ -226,17 +226,13 @@ static void serve_file(struct request *r, long long id, int attempt, const char 
 void files_get(struct request *r)
 {
 	char name[NAME_SIZE], sha[DIGEST_HEX_SIZE];
-	json_t *job = NULL;
-	struct api_error err = { 0 };
-	if (store_job_get(r->srv->store, &r->who, r->id, 0, &job, &err) != API_OK) {
-		reply_error(r, &err);
+	if (api_job_visible(r))
 		return;
-	}
-	json_decref(job);
 	if (api_file_name(r, r->name, name))
 		return;
 	int attempt;
 	long long size;
+	struct api_error err = { 0 };
 	if (store_file_find(r->srv->store, r->id, name, -1, &attempt, &size, sha, &err) != API_OK) {
 		reply_error(r, &err);
 		return;

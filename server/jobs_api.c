@@ -252,16 +252,12 @@ static int add_probe(struct results *res, const char *name, json_t *out, struct 
  * "time", "value"}}} with names in the order of the case. A job without a result file yet is 404. */
 void jobs_probes(struct request *r)
 {
-	json_t *job = NULL;
-	struct api_error err = { 0 };
-	if (store_job_get(r->srv->store, &r->who, r->id, 0, &job, &err) != API_OK) {
-		reply_error(r, &err);
+	if (api_job_visible(r))
 		return;
-	}
-	json_decref(job);
 	int attempt;
 	long long size;
 	char sha[DIGEST_HEX_SIZE], path[SERVER_PATH_MAX];
+	struct api_error err = { 0 };
 	if (store_file_find(r->srv->store, r->id, "result.h5", -1, &attempt, &size, sha, &err) != API_OK) {
 		reply_fail(r, API_NOT_FOUND, "", "job %lld has no result.h5 yet", r->id);
 		return;

@@ -76,13 +76,8 @@ static ssize_t follow_read(void *cls, uint64_t pos, char *out, size_t max)
 
 void logs_get(struct request *r)
 {
-	json_t *job = NULL;
-	struct api_error err = { 0 };
-	if (store_job_get(r->srv->store, &r->who, r->id, 0, &job, &err) != API_OK) {
-		reply_error(r, &err);
+	if (api_job_visible(r))
 		return;
-	}
-	json_decref(job);
 	long long attempt, offset, follow;
 	if (api_query_int(r, "attempt", 0, ATTEMPT_MAX, -1, &attempt) ||
 	    api_query_int(r, "offset", 0, OFFSET_MAX, 0, &offset) || api_query_int(r, "follow", 0, 1, 0, &follow))
@@ -101,6 +96,7 @@ void logs_get(struct request *r)
 	char *text = NULL;
 	size_t size = 0;
 	int live = 0;
+	struct api_error err = { 0 };
 	if (store_log_read(r->srv->store, r->id, &at, offset, &text, &size, &live, &err) != API_OK) {
 		reply_error(r, &err);
 		return;
