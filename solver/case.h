@@ -181,6 +181,11 @@ struct case_spec {
 		double ramp_time;         /* s; 0 = applied at once */
 		int elastic_loading;      /* 000 App. B.4: plastic models stay elastic during the ramp, and at
 					     its end every soil point's state becomes its reference */
+		double loading_conductivity; /* m/s; > 0: every soil point's conductivity while gravity ramps
+					     up (000 §5.4 uses 1 m/s so the loading leaves no excess pore
+					     pressure); 0 (default): the bodies' own */
+		int water_attached;       /* while gravity ramps up the water moves with the soil (000 §5.4:
+					     no seepage during the initialisation); default false */
 	} gravity;
 	struct case_boundary boundaries[FACE_COUNT];
 	int load_count;

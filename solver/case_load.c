@@ -81,7 +81,8 @@ static const char *const body_keys[] = { "name", "material", "rectangle", "polyg
 					 "porosity", "hydraulic_conductivity", "permeability_law", NULL };
 static const char *const box_keys[] = { "min", "max", NULL };
 static const char *const fluid_keys[] = { "density", "bulk_modulus", NULL };
-static const char *const gravity_keys[] = { "acceleration", "ramp_time", "elastic_loading", NULL };
+static const char *const gravity_keys[] = { "acceleration", "ramp_time", "elastic_loading", "loading_conductivity",
+						"water_attached", NULL };
 static const char *const face_boundary_keys[] = { "soil", "water", "drainage", NULL };
 static const char *const load_keys[] = { "body", "face", "from", "to", "traction", "time_function", NULL };
 static const char *const time_keys[] = { "dt", "end", NULL };
@@ -451,6 +452,12 @@ static void read_gravity(struct case_reader *r, const json_t *root, struct case_
 	if (c->gravity.elastic_loading && !(c->gravity.ramp_time > 0))
 		case_problem(r, "/gravity/elastic_loading", "needs a gravity ramp_time > 0: the elastic loading lasts "
 			     "as long as the ramp");
+	case_read_number(r, o, "/gravity", "loading_conductivity", CASE_OPTIONAL, &POSITIVE,
+			 &c->gravity.loading_conductivity);
+	case_read_bool(r, o, "/gravity", "water_attached", CASE_OPTIONAL, &c->gravity.water_attached);
+	if ((c->gravity.loading_conductivity > 0 || c->gravity.water_attached) && !(c->gravity.ramp_time > 0))
+		case_problem(r, c->gravity.water_attached ? "/gravity/water_attached" : "/gravity/loading_conductivity",
+			     "needs a gravity ramp_time > 0: it acts while gravity ramps up");
 }
 
 static void read_boundaries(struct case_reader *r, const json_t *root, struct case_boundary *faces)

@@ -44,6 +44,26 @@
 			return st_;                     \
 	} while (0)
 
+/* True while the step being taken ends within the gravity ramp: the initialisation of 000 App. B.4
+ * and §5.4, during which gravity.elastic_loading, loading_conductivity and water_attached act. */
+static int in_gravity_ramp(const struct sim *s)
+{
+	const double ramp = s->spec->gravity.ramp_time;
+	return ramp > 0 && s->time + s->dt <= ramp + 1e-9 * s->dt;
+}
+
+/* 000 App. B.4 with gravity.elastic_loading: a step that ends within the gravity ramp is elastic
+ * (1); the first step after it (2) first makes each point's present state, the one at the end of
+ * the ramp, its reference (material_reset_reference: p0, eps_v0^e, the image pressure from OCR). */
+static int gravity_loading_stage(const struct sim *s)
+{
+	if (!s->spec->gravity.elastic_loading)
+		return 0;
+	if (in_gravity_ramp(s))
+		return 1;
+	return s->time <= s->spec->gravity.ramp_time + 1e-9 * s->dt ? 2 : 0;
+}
+
 /* Step 1: shape functions and gradients of soil and (double point) water points. */
 static enum poro_status evaluate_shape_functions(struct sim *s)
 {
@@ -94,6 +114,10 @@ static void map_soil_to_grid(struct sim *s)
 	normalise(nodes, f->conductivity, 1, f->mass_s);
 	for (idx_t I = 0; I < nodes; I++)   /* where there is no soil the pores are all water */
 		f->porosity[I] = f->mass_s[I] > 0.0 ? f->porosity[I] / f->mass_s[I] : 1.0;
+	const double k_loading = s->spec->gravity.loading_conductivity;
+	if (k_loading > 0.0 && in_gravity_ramp(s))   /* 000 §5.4: drain the loading's excess pressure */
+		for (idx_t I = 0; I < nodes; I++)
+			f->conductivity[I] = f->mass_s[I] > 0.0 ? k_loading : 0.0;
 	memcpy(f->v_s_old, f->v_s, 2 * sizeof(double) * (size_t)nodes);
 }
 
@@ -253,12 +277,27 @@ static void move_points(struct sim *s, struct particles *p, const double *v_new,
 	}
 }
 
+/* 000 §5.4's initialisation with gravity.water_attached: the water points take the soil's nodal
+ * velocity (PIC) and move with it, so the loading causes no seepage between the point sets; the
+ * pressure solve still carries the water's weight. Single point: the positions are the soil's. */
+static void attach_water_to_soil(struct sim *s)
+{
+	struct particles *w = &s->water;
+	g2p_vector(&s->grid, w, s->f.v_s, w->v);
+	if (s->double_point)
+		for (idx_t k = 0; k < 2 * w->n; k++)
+			w->x[k] += s->dt * w->v[k];
+}
+
 /* Step 7: points take velocities, positions and the new pore pressure from the grid. */
 static void update_points(struct sim *s)
 {
 	struct grid_fields *f = &s->f;
 	move_points(s, &s->soil, f->v_s, f->v_s_old, s->soil_grad, 1);
-	move_points(s, &s->water, f->v_w, f->v_w_old, s->water_vec, s->double_point);
+	if (s->spec->gravity.water_attached && in_gravity_ramp(s))
+		attach_water_to_soil(s);
+	else
+		move_points(s, &s->water, f->v_w, f->v_w_old, s->water_vec, s->double_point);
 	if (s->spec->formulation.pore_pressure_smoothing) {
 		/* 7c with 9a: p^{t+1}_I = p^t_I + dp_I, p^t_I being the smoothed nodal pressure of
 		 * step 2 (Eq. 77's inner sum), interpolated back to the points (Eq. 77's outer sum) */
@@ -470,19 +509,6 @@ static enum poro_status update_soil_kinematics(struct sim *s)
 				      (long)bad, p->x[2 * bad], p->x[2 * bad + 1], p->volume[bad] / p->volume0[bad],
 				      s->step + 1);
 	return PORO_OK;
-}
-
-/* 000 App. B.4 with gravity.elastic_loading: a step that ends within the gravity ramp is elastic
- * (1); the first step after it (2) first makes each point's present state, the one at the end of
- * the ramp, its reference (material_reset_reference: p0, eps_v0^e, the image pressure from OCR). */
-static int gravity_loading_stage(const struct sim *s)
-{
-	const double ramp = s->spec->gravity.ramp_time, tol = 1e-9 * s->dt;
-	if (!s->spec->gravity.elastic_loading)
-		return 0;
-	if (s->time + s->dt <= ramp + tol)
-		return 1;
-	return s->time <= ramp + tol ? 2 : 0;
 }
 
 /* Step 10: stress update through the material interface (Eqs. 69-76). */

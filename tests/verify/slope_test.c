@@ -1,0 +1,168 @@
+/*
+ * slope_test.c - the Mohr-Coulomb slope of 000 §5.3 (Table 3, SRF = 2, Figs. 5-7): the same time
+ * step for k = 1e-3 and 1e-7 m/s, the low-permeability slope failing deeper and settling more,
+ * soil and water mass conserved, and the modified F-bar against the standard F-bar (Fig. 7).
+ *
+ * Cases: tests/cases/mc_slope_k{1e-3,1e-7}_{double,single}_point.json (geometry and initial state
+ * in docs/examples.md). Case time = paper time + 1 s (the elastic gravity ramp comes first).
+ *
+ * make test (reduced size): h = REDUCED_H with REDUCED_PPC^2 points per cell, dt scaled with h
+ * (the CFL number of the paper's 0.002 s at 0.5 m), to the paper's 6 s.
+ * make verify (PORO_VERIFY_LONG=1): the paper's size, h = 0.5 m, 4x4 points per cell,
+ * dt = 0.002 s, to 6 s.
+ *
+ * Measured per run: crest settlement (probe 0 of the cases: the soil point nearest the crest
+ * edge), the points mobilised (displacement above one cell) and the lowest initial height among
+ * them (the depth of the failure), the oscillation index of the mean effective stress
+ * (solver/oscillation.h) at the paper's 2, 4 and 6 s, and the mass balance of both phases.
+ */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+#include "../harness.h"
+#include "case.h"
+#include "oscillation.h"
+#include "particles.h"
+#include "poro.h"
+
+#define CASE_DIR "tests/cases/"
+#define PAPER_H 0.5                 /* m */
+#define REDUCED_H 1.0               /* m: Table 4's cell (Table 4 itself runs 6x6 and more per cell) */
+#define REDUCED_PPC 2
+#define INITIALISATION 1.0          /* s: the gravity ramp before the paper's t = 0 */
+#define MASS_TOLERANCE 1e-12        /* relative: points carry constant masses, outflow is booked */
+#define SNAPSHOTS 3
+static const double snapshot_paper_time[SNAPSHOTS] = {2.0, 4.0, 6.0};   /* 000 Fig. 7 */
+
+struct slope_run {
+	int ok;
+	long steps;
+	double dt, settlement, lowest_mobilised, seconds;
+	long mobilised;
+	double oscillation[SNAPSHOTS];
+	double soil_mass_error, water_mass_error;
+};
+
+static double wall(void)
+{
+	struct timespec ts;
+	clock_gettime(CLOCK_MONOTONIC, &ts);
+	return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+/* Mobilised soil: points displaced by more than one cell; the lowest initial height among them
+ * marks how deep the failure reaches. */
+static void measure_failure(const struct particles *p, double h, struct slope_run *r)
+{
+	r->mobilised = 0;
+	r->lowest_mobilised = INFINITY;
+	for (idx_t q = 0; q < p->n; q++) {
+		double ux = p->x[2 * q] - p->x0[2 * q], uy = p->x[2 * q + 1] - p->x0[2 * q + 1];
+		if (hypot(ux, uy) > h) {
+			r->mobilised++;
+			r->lowest_mobilised = fmin(r->lowest_mobilised, p->x0[2 * q + 1]);
+		}
+	}
+}
+
+static struct slope_run run_slope(const char *file, double h, int ppc, enum soil_stabilisation stabilisation)
+{
+	struct slope_run r = {0};
+	struct case_spec *c = NULL;
+	struct sim *s = NULL;
+	struct poro_error err = {0};
+	r.ok = !case_load_file(file, &c, &err);
+	if (r.ok) {
+		c->time.dt *= h / c->grid.cell_size;   /* same CFL number */
+		c->grid.cell_size = h;
+		c->bodies[0].particles_per_cell = ppc;
+		c->formulation.soil_stabilisation = stabilisation;
+		r.dt = c->time.dt;
+		r.ok = !sim_create(&s, c, &err);
+	}
+	if (!r.ok) {
+		printf("INFO cannot run %s: %s\n", file, err.message);
+		case_destroy(&c);
+		return r;
+	}
+	const double soil0 = sim_soil_mass(s), water0 = sim_water_mass(s), t0 = wall();
+	int next = 0;
+	while (r.ok && !sim_done(s)) {
+		r.ok = !sim_step(s);
+		r.steps++;
+		if (r.ok && next < SNAPSHOTS && sim_time(s) >= INITIALISATION + snapshot_paper_time[next] - 0.5 * r.dt) {
+			if (oscillation_index(&c->grid, sim_soil(s), h / ppc, &r.oscillation[next], &err))
+				r.ok = 0, printf("INFO oscillation index: %s\n", err.message);
+			next++;
+		}
+	}
+	r.seconds = wall() - t0;
+	if (!r.ok && s && sim_error(s)->code)
+		printf("INFO %s failed at t = %.4f s: %s\n", file, sim_time(s), sim_error(s)->message);
+	r.settlement = -sim_probe_value(s, 0);
+	measure_failure(sim_soil(s), h, &r);
+	r.soil_mass_error = fabs(sim_soil_mass(s) - soil0) / soil0;
+	r.water_mass_error = fabs(sim_water_mass(s) + sim_water_outflow_mass(s) - water0) / water0;
+	sim_destroy(&s);
+	case_destroy(&c);
+	return r;
+}
+
+static void report(const char *label, double h, int ppc, const struct slope_run *r)
+{
+	printf("INFO mc slope %s h=%.2f m %dx%d dt=%.4f s: %s after %ld steps, crest settlement %.3f m, %ld points "
+	       "mobilised (|u| > h) down to initial y = %.2f m, oscillation index at paper t = 2/4/6 s "
+	       "%.4f/%.4f/%.4f, mass error soil %.1e water %.1e, run time %.1f s\n", label, h, ppc, ppc, r->dt,
+	       r->ok ? "ran to the end" : "FAILED", r->steps, r->settlement, r->mobilised, r->lowest_mobilised,
+	       r->oscillation[0], r->oscillation[1], r->oscillation[2], r->soil_mass_error, r->water_mass_error,
+	       r->seconds);
+}
+
+static void check_slope(double h, int ppc, const char *size)
+{
+	char name[128];
+	struct slope_run high = run_slope(CASE_DIR "mc_slope_k1e-3_double_point.json", h, ppc,
+					  STABILISATION_MODIFIED_FBAR);
+	struct slope_run low = run_slope(CASE_DIR "mc_slope_k1e-7_double_point.json", h, ppc,
+					 STABILISATION_MODIFIED_FBAR);
+	struct slope_run fbar = run_slope(CASE_DIR "mc_slope_k1e-3_double_point.json", h, ppc, STABILISATION_FBAR);
+	report("k=1e-3 double point modified F-bar", h, ppc, &high);
+	report("k=1e-7 double point modified F-bar", h, ppc, &low);
+	report("k=1e-3 double point standard F-bar", h, ppc, &fbar);
+
+	snprintf(name, sizeof name, "mc_slope_%s_both_permeabilities_run_at_one_dt", size);
+	CHECK(high.ok && low.ok && high.dt == low.dt, name, "k=1e-3 %s, k=1e-7 %s", high.ok ? "ok" : "failed",
+	      low.ok ? "ok" : "failed");
+	snprintf(name, sizeof name, "mc_slope_%s_mass_conserved", size);
+	CHECK(high.ok && low.ok && fmax(high.soil_mass_error, high.water_mass_error) < MASS_TOLERANCE &&
+	      fmax(low.soil_mass_error, low.water_mass_error) < MASS_TOLERANCE, name,
+	      "soil %.1e/%.1e water %.1e/%.1e", high.soil_mass_error, low.soil_mass_error, high.water_mass_error,
+	      low.water_mass_error);
+	snprintf(name, sizeof name, "mc_slope_%s_low_permeability_settles_more", size);
+	/* Not reproduced (docs/examples.md): at k = 1e-7 m/s the scarp behind the crest dilates at the
+	 * Mohr-Coulomb apex, the water cannot follow, and the suction (to -1.9 MPa at full size)
+	 * stiffens the slope, so the high-permeability slope moves more. */
+	CHECK_KNOWN_FAILURE(high.ok && low.ok && low.settlement > high.settlement, name, "crest settlement k=1e-7 %.3f m vs "
+	      "k=1e-3 %.3f m (000 Fig. 6)", low.settlement, high.settlement);
+	snprintf(name, sizeof name, "mc_slope_%s_low_permeability_fails_deeper", size);
+	CHECK_KNOWN_FAILURE(high.ok && low.ok && low.mobilised > high.mobilised, name, "mobilised points k=1e-7 %ld vs k=1e-3 %ld "
+	      "(000 §5.3: more points mobilised)", low.mobilised, high.mobilised);
+	for (int i = 0; i < SNAPSHOTS; i++) {
+		snprintf(name, sizeof name, "mc_slope_%s_modified_fbar_smoother_than_fbar_t%.0f", size,
+			 snapshot_paper_time[i]);
+		CHECK(high.ok && fbar.ok && high.oscillation[i] < fbar.oscillation[i], name,
+		      "oscillation index modified %.4f vs F-bar %.4f (000 Fig. 7)", high.oscillation[i],
+		      fbar.oscillation[i]);
+	}
+}
+
+int main(void)
+{
+	check_slope(REDUCED_H, REDUCED_PPC, "reduced");
+	const char *long_runs = getenv("PORO_VERIFY_LONG");
+	if (long_runs && *long_runs && strcmp(long_runs, "0") != 0)
+		check_slope(PAPER_H, 4, "paper_size");
+	HARNESS_EXIT();
+}
