@@ -8,6 +8,13 @@
  *   poro-solve element CASE.json --out DIR
  *                                        single-element triaxial test (element.h, docs/element.md):
  *                                        DIR/element.csv and DIR/element.svg
+ *   poro-solve report RESULT.h5 [--out FILE] [--ground Y] [--crest X] [--tolerance M]
+ *                     [--line X0,Y0,X1,Y1[,N] --line-out FILE [--at TIME]]
+ *                                        derived quantities of a run (report.h, docs/report.md): a
+ *                                        CSV row per frame (toe, run-out, crest settlement, soil-water
+ *                                        gap, oscillation index) to stdout or FILE, and the pore
+ *                                        pressure along a line at the frame nearest TIME (default the
+ *                                        last) to the --line-out FILE
  *   poro-solve version
  *
  * run writes DIR/checkpoint.h5 every checkpoint.interval of simulated time (case key) and every
@@ -20,6 +27,8 @@
  * (NaN, a point leaving the grid, a failed factorisation), 4 I/O, 5 out of memory, 6 interrupted.
  * Progress goes to stdout, one line per report; errors to stderr, prefixed "poro-solve: ".
  */
+#include <errno.h>
+#include <math.h>
 #include <signal.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -29,6 +38,7 @@
 #include "checkpoint.h"
 #include "element.h"
 #include "poro.h"
+#include "report.h"
 
 #ifndef PORO_VERSION
 #define PORO_VERSION "unknown"
@@ -47,6 +57,8 @@ static int usage(void)
 	fprintf(stderr, "usage: poro-solve run CASE.json --out DIR [--resume CHECKPOINT] [--checkpoint-wall SECONDS]\n"
 			"       poro-solve validate CASE.json\n"
 			"       poro-solve element CASE.json --out DIR\n"
+			"       poro-solve report RESULT.h5 [--out FILE] [--ground Y] [--crest X] [--tolerance M]\n"
+			"                         [--line X0,Y0,X1,Y1[,N] --line-out FILE [--at TIME]]\n"
 			"       poro-solve version\n");
 	return 2;
 }
@@ -115,6 +127,14 @@ static int cmd_element(const char *path, const char *out_dir)
 	return 0;
 }
 
+/* text as a whole finite number into *value; -1 when it is not one. */
+static int parse_number(const char *text, double *value)
+{
+	char *end;
+	*value = strtod(text, &end);
+	return end == text || *end || !isfinite(*value) ? -1 : 0;
+}
+
 /* What `run` was asked for besides the case. */
 struct run_options {
 	const char *out_dir;
@@ -172,9 +192,8 @@ static int parse_run(int argc, char **argv)
 		} else if (!strcmp(argv[i], "--resume")) {
 			opt.resume = argv[i + 1];
 		} else if (!strcmp(argv[i], "--checkpoint-wall")) {
-			char *end;
-			opt.checkpoint_wall = strtod(argv[i + 1], &end);
-			if (end == argv[i + 1] || *end || !(opt.checkpoint_wall > 0) || opt.checkpoint_wall > 1e9) {
+			if (parse_number(argv[i + 1], &opt.checkpoint_wall) || !(opt.checkpoint_wall > 0) ||
+			    opt.checkpoint_wall > 1e9) {
 				fprintf(stderr, "poro-solve: --checkpoint-wall: '%s' is not a number of seconds > 0\n",
 					argv[i + 1]);
 				return 2;
@@ -184,6 +203,115 @@ static int parse_run(int argc, char **argv)
 		}
 	}
 	return opt.out_dir ? cmd_run(argv[2], &opt) : usage();
+}
+
+/* What `report` was asked for besides the result file. */
+struct report_options {
+	const char *out;            /* the per-frame table, or NULL for stdout */
+	const char *line;           /* "X0,Y0,X1,Y1[,N]", or NULL for no line */
+	const char *line_out;       /* the line table */
+	double at;                  /* s, NAN = the last frame */
+	struct report_settings settings;
+};
+
+/* Opens path for writing, or reports why not (exit 4) and returns NULL. */
+static FILE *create_output(const char *path)
+{
+	FILE *f = fopen(path, "w");
+	if (!f) {
+		struct poro_error err = {0};
+		fail(poro_error_set(&err, PORO_EIO, "cannot create '%s': %s", path, strerror(errno)), &err, path);
+	}
+	return f;
+}
+
+/* Writes the two tables once everything is computed, so invalid input leaves no file behind. */
+static int write_report(const struct report_options *opt, const struct report_row *rows, long count,
+			const struct report_sample *samples, int sample_count)
+{
+	struct poro_error err = {0};
+	FILE *f = opt->out ? create_output(opt->out) : stdout;
+	if (!f)
+		return poro_status_exit_code(PORO_EIO);
+	enum poro_status st = report_frames_write(f, opt->out ? opt->out : "stdout", rows, count, &err);
+	if (opt->out && fclose(f) != 0 && !st)
+		st = poro_error_set(&err, PORO_EIO, "cannot write '%s': %s", opt->out, strerror(errno));
+	if (!st && samples) {
+		if (!(f = create_output(opt->line_out)))
+			return poro_status_exit_code(PORO_EIO);
+		st = report_line_write(f, opt->line_out, samples, sample_count, &err);
+		if (fclose(f) != 0 && !st)
+			st = poro_error_set(&err, PORO_EIO, "cannot write '%s': %s", opt->line_out, strerror(errno));
+	}
+	return st ? fail(st, &err, "report") : 0;
+}
+
+static int cmd_report(const char *path, const struct report_options *opt)
+{
+	struct report *rep = NULL;
+	struct report_row *rows = NULL;
+	struct report_sample *samples = NULL;
+	struct report_line line = {0};
+	struct poro_error err = {0};
+	double frame_time = NAN;
+	long count = 0;
+	enum poro_status st = opt->line ? report_line_parse(opt->line, &line, &err) : PORO_OK;
+	if (st)
+		return fail(st, &err, "--line");
+	if (!(st = report_open(&rep, path, &opt->settings, &err)))
+		st = report_frames(rep, &rows, &count, &err);
+	if (!st && opt->line)
+		st = report_line_sample(rep, &line, opt->at, &samples, &frame_time, &err);
+	int code = st ? fail(st, &err, path) : write_report(opt, rows, count, samples, line.samples);
+	if (!code && opt->out) {
+		const struct report_settings *set = report_settings_used(rep);
+		printf("report: %ld frames, ground y = %.9g m, crest x = %.9g m, tolerance %.9g m: %s\n", count,
+		       set->ground, set->crest, set->tolerance, opt->out);
+		if (samples)
+			printf("line: %d samples at the frame of t = %.9g s: %s\n", line.samples, frame_time, opt->line_out);
+	}
+	free(rows);
+	free(samples);
+	report_close(&rep);
+	return code;
+}
+
+/* One refused command line of `report`: the problem, then the usage. */
+static int report_usage(const char *problem, const char *subject)
+{
+	fprintf(stderr, "poro-solve: report: %s '%s'\n", problem, subject);
+	return usage();
+}
+
+/* report RESULT.h5 [options], options in any order (struct report_options). */
+static int parse_report(int argc, char **argv)
+{
+	struct report_options opt = {.at = NAN, .settings = REPORT_SETTINGS_DEFAULT};
+	for (int i = 3; i < argc; i += 2) {
+		const char *key = argv[i], *value = i + 1 < argc ? argv[i + 1] : NULL;
+		double *number = !strcmp(key, "--ground") ? &opt.settings.ground :
+				 !strcmp(key, "--crest") ? &opt.settings.crest :
+				 !strcmp(key, "--tolerance") ? &opt.settings.tolerance :
+				 !strcmp(key, "--at") ? &opt.at : NULL;
+		const char **text = !strcmp(key, "--out") ? &opt.out :
+				    !strcmp(key, "--line") ? &opt.line :
+				    !strcmp(key, "--line-out") ? &opt.line_out : NULL;
+		if (!number && !text)
+			return report_usage("unknown option", key);
+		if (!value)
+			return report_usage("no value after", key);
+		if (number && parse_number(value, number)) {
+			fprintf(stderr, "poro-solve: %s: '%s' is not a number\n", key, value);
+			return 2;
+		}
+		if (text)
+			*text = value;
+	}
+	if (opt.line && !opt.line_out)
+		return report_usage("no --line-out FILE for", "--line");
+	if (!opt.line && (opt.line_out || !isnan(opt.at)))
+		return report_usage("no --line for", opt.line_out ? "--line-out" : "--at");
+	return cmd_report(argv[2], &opt);
 }
 
 int main(int argc, char **argv)
@@ -196,6 +324,8 @@ int main(int argc, char **argv)
 		return cmd_validate(argv[2]);
 	if (argc >= 3 && !strcmp(argv[1], "run"))
 		return parse_run(argc, argv);
+	if (argc >= 3 && !strcmp(argv[1], "report"))
+		return parse_report(argc, argv);
 	if (argc == 5 && !strcmp(argv[1], "element") && !strcmp(argv[3], "--out"))
 		return cmd_element(argv[2], argv[4]);
 	return usage();

@@ -171,18 +171,25 @@ static enum poro_status count_frames(struct results *r, struct poro_error *err)
 	return PORO_OK;
 }
 
+/* Opens path read-only, or returns < 0 with the reason in hdf5_reason. */
+static hid_t open_read_only(const char *path)
+{
+	hid_t file = H5I_INVALID_HID, fapl = H5Pcreate(H5P_FILE_ACCESS);
+	/* STRONG: closing the file closes anything left open; no locking: the writer takes none */
+	if (fapl >= 0 && H5Pset_fclose_degree(fapl, H5F_CLOSE_STRONG) >= 0 &&
+	    H5Pset_file_locking(fapl, 0, 1) >= 0)
+		file = H5Fopen(path, H5F_ACC_RDONLY, fapl);
+	if (fapl >= 0)
+		H5Pclose(fapl);
+	return file;
+}
+
 static enum poro_status open_file(struct results *r, struct poro_error *err)
 {
 	struct stat sb;
 	if (stat(r->path, &sb) != 0)
 		return poro_error_set(err, PORO_EIO, "cannot open '%s': %s", r->path, strerror(errno));
-	hid_t fapl = H5Pcreate(H5P_FILE_ACCESS);
-	/* STRONG: closing the file closes anything left open; no locking: the writer takes none */
-	if (fapl >= 0 && H5Pset_fclose_degree(fapl, H5F_CLOSE_STRONG) >= 0 &&
-	    H5Pset_file_locking(fapl, 0, 1) >= 0)
-		r->file = H5Fopen(r->path, H5F_ACC_RDONLY, fapl);
-	if (fapl >= 0)
-		H5Pclose(fapl);
+	r->file = open_read_only(r->path);
 	if (r->file < 0)
 		return poro_error_set(err, PORO_EIO, "cannot open '%s'%s%s", r->path, hdf5_reason[0] ? ": " : "",
 				      hdf5_reason);
@@ -211,6 +218,54 @@ enum poro_status results_open(struct results **out, const char *path, struct por
 		results_close(&r);
 	*out = r;
 	return quiet_end(h, st);
+}
+
+/* What an HDF5 file lacks to be a result file, or NULL when it has /case "json" and /run. */
+static const char *missing_result_object(hid_t file)
+{
+	if (H5Lexists(file, "/case", H5P_DEFAULT) <= 0 || H5Aexists_by_name(file, "/case", "json", H5P_DEFAULT) <= 0)
+		return "it has no /case json";
+	if (H5Lexists(file, "/run", H5P_DEFAULT) <= 0)
+		return "it has no /run";
+	return NULL;
+}
+
+static int is_hdf5(const char *path)
+{
+#if H5_VERSION_GE(1, 12, 0)
+	return H5Fis_accessible(path, H5P_DEFAULT) > 0;
+#else
+	return H5Fis_hdf5(path) > 0;
+#endif
+}
+
+enum poro_status results_check_file(const char *path, struct poro_error *err)
+{
+	struct stat sb;
+	if (!path)
+		return poro_error_set(err, PORO_EINVAL, "cannot check results: no path");
+	FILE *f = fopen(path, "rb");
+	if (!f || fstat(fileno(f), &sb) != 0) {
+		int e = errno;
+		if (f)
+			fclose(f);
+		return poro_error_set(err, PORO_EIO, "cannot open '%s': %s", path, strerror(e));
+	}
+	fclose(f);
+	if (S_ISDIR(sb.st_mode))
+		return poro_error_set(err, PORO_EINVAL, "'%s' is not a result file: it is a directory", path);
+	struct handler h = quiet_begin();
+	if (!is_hdf5(path))
+		return quiet_end(h, poro_error_set(err, PORO_EINVAL, "'%s' is not a result file: not an HDF5 file", path));
+	hid_t file = open_read_only(path);
+	if (file < 0)
+		return quiet_end(h, poro_error_set(err, PORO_EIO, "cannot open '%s'%s%s", path,
+						   hdf5_reason[0] ? ": " : "", hdf5_reason));
+	const char *missing = missing_result_object(file);
+	H5Fclose(file);
+	if (missing)
+		return quiet_end(h, poro_error_set(err, PORO_EINVAL, "'%s' is not a result file: %s", path, missing));
+	return quiet_end(h, PORO_OK);
 }
 
 void results_close(struct results **rp)

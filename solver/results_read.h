@@ -37,6 +37,14 @@ struct results;
  * going"). On failure *r is NULL. Close with results_close(). */
 enum poro_status results_open(struct results **r, const char *path, struct poro_error *err);
 
+/* Whether path is a result file, for callers that treat a wrong file as invalid input rather than
+ * an I/O error (results_open() reports both as PORO_EIO). Opens nothing it keeps. Returns PORO_OK
+ * for an HDF5 file with the /case "json" attribute and the /run group, which a result.h5 has from
+ * its creation; PORO_EINVAL naming the file and what it lacks when it can be read but is no result
+ * file (a directory, not HDF5 at all, or HDF5 without them, such as a checkpoint.h5); PORO_EIO
+ * naming the file when it cannot be opened (missing, no permission). */
+enum poro_status results_check_file(const char *path, struct poro_error *err);
+
 /* Closes the file and frees r; accepts NULL and clears the pointer. */
 void results_close(struct results **r);
 

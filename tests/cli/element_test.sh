@@ -6,13 +6,9 @@
 # are refused with exit 2 and the JSON pointer of the value. Prints "PASS name" / "FAIL name: why".
 #   bash tests/cli/element_test.sh BUILD_DIR      (from the repository root)
 set -u
-build=${1:-build}
 cd "$(dirname "$0")/../.."
-solve="$build/poro-solve"
-tmp=$(mktemp -d)
-trap 'rm -rf "$tmp"' EXIT
-
 . tests/cli/lib.sh
+cli_setup "${1:-build}"
 
 # ---- every element case runs and writes its two files ------------------------------------------
 

@@ -1,7 +1,10 @@
 #!/usr/bin/env bash
-# lib.sh - helpers for the command-line tests: source it after setting $solve (the poro-solve
-# binary) and $tmp (a temporary directory the test removes).
+# lib.sh - helpers for the command-line tests: source it from the repository root, then call
+# cli_setup, or set $solve (the poro-solve binary) and $tmp (a temporary directory the test
+# removes) yourself.
 #
+#   cli_setup BUILD_DIR                   $build, $solve = BUILD_DIR/poro-solve, and $tmp, a fresh
+#                                         directory removed when the script exits
 #   check NAME STATUS WHY                 "PASS NAME" when STATUS is 0, else "FAIL NAME: WHY"
 #   derive_material NAME MATERIAL PYTHON  $tmp/NAME.json: tests/cases/terzaghi.json with its first
 #                                         material updated by the JSON object MATERIAL (keys whose
@@ -9,11 +12,19 @@
 #                                         PYTHON run with c (the case) and m (the material)
 #   expect_invalid NAME POINTER [FILE]    `poro-solve validate` of FILE ($tmp/NAME.json) exits 2 and
 #                                         names POINTER; the check is called validate_NAME_...
-#   derive_element NAME BASE PYTHON       $tmp/NAME.json: the element case BASE after the python
-#                                         statement PYTHON run with c (the element case)
+#   derive_case NAME BASE PYTHON          $tmp/NAME.json: the case BASE after the python statement
+#                                         PYTHON run with c (the case)
+#   derive_element NAME BASE PYTHON       the same for an element case
 #   expect_element_refused NAME FILE POINTER...
 #                                         `poro-solve element FILE` exits 2, names every POINTER and
 #                                         writes no element.csv
+
+cli_setup() {
+	build=$1
+	solve="$build/poro-solve"
+	tmp=$(mktemp -d)
+	trap 'rm -rf "$tmp"' EXIT
+}
 
 check() {
 	if [ "$2" -eq 0 ]; then echo "PASS $1"; else echo "FAIL $1: $3"; fi
@@ -43,7 +54,7 @@ expect_invalid() {
 		"exit $rc, wanted 2 and '$2: ...' in: $(head -c 300 "$tmp/err")"
 }
 
-derive_element() {
+derive_case() {
 	python3 - "$2" "$tmp/$1.json" "$3" <<'EOF2'
 import json, sys
 c = json.load(open(sys.argv[1]))
@@ -51,6 +62,8 @@ exec(sys.argv[3])
 json.dump(c, open(sys.argv[2], "w"))
 EOF2
 }
+
+derive_element() { derive_case "$@"; }
 
 expect_element_refused() {
 	local name=$1 file=$2 rc ok=0 pointer

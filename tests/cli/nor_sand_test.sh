@@ -6,13 +6,9 @@
 # Prints "PASS name" / "FAIL name: why".
 #   bash tests/cli/nor_sand_test.sh BUILD_DIR      (from the repository root)
 set -u
-build=${1:-build}
 cd "$(dirname "$0")/../.."
-solve="$build/poro-solve"
-tmp=$(mktemp -d)
-trap 'rm -rf "$tmp"' EXIT
-
 . tests/cli/lib.sh
+cli_setup "${1:-build}"
 
 # 000 Table 6 (Hostun sand); the elastic constants of the base case are not Nor-Sand keys
 HOSTUN='{"model": "nor_sand", "youngs_modulus": null, "poisson_ratio": null, "shear_modulus": 40e6,

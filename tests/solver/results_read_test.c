@@ -305,6 +305,26 @@ static void check_open_errors(const char *dir)
 	CHECK(printed == 0, "open_errors_print_nothing", "%ld bytes written to stderr", printed);
 }
 
+/* results_check_file() tells a result file, a wrong file (invalid input) and a missing one (I/O). */
+static void check_file_kinds(const char *run_dir, const char *dir)
+{
+	char result[128], missing[128], plain[128];
+	struct poro_error err = {0}, plain_err = {0}, dir_err = {0};
+	harness_join(result, sizeof result, run_dir, "result.h5");
+	harness_join(plain, sizeof plain, dir, "plain.h5");   /* written by check_open_errors() */
+	enum poro_status ok = results_check_file(result, &err);
+	enum poro_status absent = results_check_file(harness_join(missing, sizeof missing, dir, "absent.h5"), &err);
+	enum poro_status text = results_check_file(plain, &plain_err);
+	enum poro_status folder = results_check_file(run_dir, &dir_err);
+	CHECK(ok == PORO_OK, "check_file_accepts_result", "status %d", ok);
+	CHECK(absent == PORO_EIO && strstr(err.message, missing), "check_file_missing_is_eio_naming_path",
+	      "status %d: %s", absent, err.message);
+	CHECK(text == PORO_EINVAL && strstr(plain_err.message, plain) && strstr(plain_err.message, "not an HDF5 file"),
+	      "check_file_non_hdf5_is_einval", "status %d: %s", text, plain_err.message);
+	CHECK(folder == PORO_EINVAL && strstr(dir_err.message, "directory"), "check_file_directory_is_einval",
+	      "status %d: %s", folder, dir_err.message);
+}
+
 static void check_read_errors(const char *run_dir, const char *dir)
 {
 	char path[128], object[64], dataset_msg[PORO_ERROR_MESSAGE_MAX];
@@ -347,6 +367,7 @@ int main(void)
 	check_run("single_point", sp);
 	check_running_file(killed);
 	check_read_errors(dp, scratch);
+	check_file_kinds(dp, scratch);
 	if (!harness_failed_count) {
 		harness_remove_dir(dp);
 		harness_remove_dir(sp);

@@ -1,0 +1,147 @@
+/*
+ * report_frames.c - the per-frame table of a report (report.h): toe and run-out, crest settlement,
+ * the largest gap between the soil and water surfaces, and the oscillation index of the mean
+ * effective stress, from each frame's soil (and water) points. Definitions in report.h and
+ * docs/report.md; each quantity is one pass over a frame's points.
+ *
+ * The oscillation index is oscillation_index() itself (oscillation.h), given a read-only view of
+ * the frame's soil points: their reference positions x0 = x - displacement (the seeding lattice
+ * it places points on; the subtraction undoes the writer's x - x0 to round-off, far inside the
+ * half spacing that floor() in oscillation.c tolerates) and their stress.
+ */
+#include "report_internal.h"
+
+#include <stdlib.h>
+
+#include "oscillation.h"
+#include "particles.h"
+
+/* Largest x of the points above `level`, NaN when none is. */
+static double toe(const double *x, long n, double level)
+{
+	double toe_x = -INFINITY;
+	for (long i = 0; i < n; i++)
+		if (x[2 * i + 1] > level && x[2 * i] > toe_x)
+			toe_x = x[2 * i];
+	return isinf(toe_x) ? NAN : toe_x;
+}
+
+/* Surface height at `at`: the largest y of the points within `half` of it in x, NaN when none is. */
+static double surface(const double *x, long n, double at, double half)
+{
+	double top = -INFINITY;
+	for (long i = 0; i < n; i++)
+		if (fabs(x[2 * i] - at) <= half && x[2 * i + 1] > top)
+			top = x[2 * i + 1];
+	return isinf(top) ? NAN : top;
+}
+
+/* top[i] = the largest y of the points in column i, -INFINITY for an empty column. */
+static void column_tops(const struct report *rep, const double *x, long n, double *top)
+{
+	const double origin = rep->spec->grid.origin[0];
+	for (long i = 0; i < rep->columns; i++)
+		top[i] = -INFINITY;
+	for (long q = 0; q < n; q++) {
+		long i = (long)floor((x[2 * q] - origin) / rep->h);
+		i = i < 0 ? 0 : i >= rep->columns ? rep->columns - 1 : i;   /* a point on the grid's right edge */
+		if (x[2 * q + 1] > top[i])
+			top[i] = x[2 * q + 1];
+	}
+}
+
+/* The largest soil-over-water gap among the columns holding both sets, and its column's centre. */
+static void largest_gap(struct report *rep, const double *soil, long ns, const double *water, long nw,
+			struct report_row *row)
+{
+	column_tops(rep, soil, ns, rep->top_soil);
+	column_tops(rep, water, nw, rep->top_water);
+	row->max_gap = row->max_gap_x = NAN;
+	for (long i = 0; i < rep->columns; i++) {
+		if (isinf(rep->top_soil[i]) || isinf(rep->top_water[i]))
+			continue;
+		double gap = rep->top_soil[i] - rep->top_water[i];
+		if (isnan(row->max_gap) || gap > row->max_gap) {
+			row->max_gap = gap;
+			row->max_gap_x = rep->spec->grid.origin[0] + (i + 0.5) * rep->h;
+		}
+	}
+}
+
+/* The oscillation index of the soil points x[n] of a frame; NaN where oscillation_index() finds it
+ * undefined (PORO_EINVAL: zero stress, no point with two lattice neighbours). */
+static enum poro_status oscillation(struct report *rep, long frame, const double *x, long n, double *index,
+				    struct poro_error *err)
+{
+	double *x0 = NULL, *stress = NULL;
+	long rows_u = 0, rows_s = 0;
+	enum poro_status st = report_read(rep, frame, "soil", "displacement", 2, &x0, &rows_u, err);
+	if (!st)
+		st = report_read(rep, frame, "soil", "stress", 4, &stress, &rows_s, err);
+	if (!st && (rows_u != n || rows_s != n))
+		st = poro_error_set(err, PORO_EIO, "frame %ld of '%s': %ld soil positions but %ld displacements and "
+				    "%ld stresses", frame, rep->path, n, rows_u, rows_s);
+	if (!st) {
+		for (long k = 0; k < 2 * n; k++)
+			x0[k] = x[k] - x0[k];
+		const struct particles view = {.n = (idx_t)n, .x0 = x0, .stress = stress};
+		struct poro_error undefined = {0};
+		st = oscillation_index(&rep->spec->grid, &view, rep->spacing, index, &undefined);
+		if (st == PORO_EINVAL)
+			*index = NAN, st = PORO_OK;
+		else if (st)
+			*err = undefined;
+	}
+	free(x0);
+	free(stress);
+	return st;
+}
+
+/* One frame's row but for the differences to the first frame (runout, crest_settlement), and the
+ * surface height at the crest in *top. */
+static enum poro_status frame_row(struct report *rep, long frame, struct report_row *row, double *top,
+				  struct poro_error *err)
+{
+	const struct report_settings *set = &rep->settings;
+	double *soil = NULL, *water = NULL;
+	long ns = 0, nw = 0;
+	enum poro_status st = results_frame_time(rep->results, frame, &row->time, err);
+	if (!st)
+		st = report_read(rep, frame, "soil", "x", 2, &soil, &ns, err);
+	if (st)
+		return st;
+	row->toe_x = toe(soil, ns, set->ground + set->tolerance);
+	*top = surface(soil, ns, set->crest, REPORT_CREST_HALF_WIDTH * rep->h);
+	row->max_gap = row->max_gap_x = NAN;
+	if (rep->double_point && !(st = report_read(rep, frame, "water", "x", 2, &water, &nw, err)))
+		largest_gap(rep, soil, ns, water, nw, row);
+	if (!st)
+		st = oscillation(rep, frame, soil, ns, &row->oscillation_index, err);
+	free(soil);
+	free(water);
+	return st;
+}
+
+enum poro_status report_frames(struct report *rep, struct report_row **out, long *count, struct poro_error *err)
+{
+	*out = NULL;
+	*count = 0;
+	struct report_row *rows = calloc((size_t)rep->frames, sizeof *rows);
+	double *top = calloc((size_t)rep->frames, sizeof *top);
+	enum poro_status st = rows && top ? PORO_OK :
+		poro_error_set(err, PORO_ENOMEM, "cannot allocate %ld report rows", rep->frames);
+	for (long k = 0; !st && k < rep->frames; k++)
+		st = frame_row(rep, k, &rows[k], &top[k], err);
+	for (long k = 0; !st && k < rep->frames; k++) {
+		rows[k].runout = rows[k].toe_x - rows[0].toe_x;
+		rows[k].crest_settlement = top[0] - top[k];
+	}
+	free(top);
+	if (st) {
+		free(rows);
+		return st;
+	}
+	*out = rows;
+	*count = rep->frames;
+	return PORO_OK;
+}
