@@ -7,15 +7,26 @@
  */
 #include "transfer.h"
 
-/* Iterates the support nodes of point q: node index `I`, shape weight `wk`, gradient `gx`, `gy`. */
+/* Iterates the support nodes of point q: node index `I`, shape weight `wk`, gradient `gx`, `gy`.
+ * The quadratic B-spline's 3x3 support (the default shape) gets its own copy of the body with
+ * the support a constant, so the compiler unrolls it; the order of the sums is the same. */
 #define FOR_SUPPORT(g, p, q, ...)                                                    \
 	do {                                                                         \
-		const int S_ = (p)->support, nn_ = S_ * S_;                          \
+		if ((p)->support == 3)                                               \
+			FOR_SUPPORT_OF(3, g, p, q, __VA_ARGS__);                     \
+		else                                                                 \
+			FOR_SUPPORT_OF((p)->support, g, p, q, __VA_ARGS__);          \
+	} while (0)
+
+/* FOR_SUPPORT on a support of S nodes per direction. */
+#define FOR_SUPPORT_OF(S, g, p, q, ...)                                              \
+	do {                                                                         \
+		const int S_ = (S), nn_ = S_ * S_;                                   \
 		const double *w_ = (p)->w + (size_t)(q) * nn_;                       \
 		const double *dw_ = (p)->dw + (size_t)(q) * 2 * nn_;                 \
 		const idx_t base_ = (p)->node0[q];                                   \
-		for (int b_ = 0; b_ < S_; b_++)                                      \
-			for (int a_ = 0; a_ < S_; a_++) {                            \
+		_Pragma("GCC unroll 4") for (int b_ = 0; b_ < S_; b_++)              \
+			_Pragma("GCC unroll 4") for (int a_ = 0; a_ < S_; a_++) {    \
 				const int k_ = a_ + b_ * S_;                         \
 				const idx_t I = base_ + a_ + b_ * (g)->nodes[0];     \
 				const double wk = w_[k_];                            \
