@@ -44,12 +44,18 @@
 			return st_;                     \
 	} while (0)
 
+/* Time t is at or before the end of the gravity ramp; steps are compared within a billionth of dt,
+ * so the step that lands on the ramp's end by rounding still counts as inside it. */
+static int by_ramp_end(const struct sim *s, double t)
+{
+	return t <= s->spec->gravity.ramp_time + 1e-9 * s->dt;
+}
+
 /* True while the step being taken ends within the gravity ramp: the initialisation of 000 App. B.4
  * and §5.4, during which gravity.elastic_loading, loading_conductivity and water_attached act. */
 static int in_gravity_ramp(const struct sim *s)
 {
-	const double ramp = s->spec->gravity.ramp_time;
-	return ramp > 0 && s->time + s->dt <= ramp + 1e-9 * s->dt;
+	return s->spec->gravity.ramp_time > 0 && by_ramp_end(s, s->time + s->dt);
 }
 
 /* 000 App. B.4 with gravity.elastic_loading: a step that ends within the gravity ramp is elastic
@@ -61,7 +67,7 @@ static int gravity_loading_stage(const struct sim *s)
 		return 0;
 	if (in_gravity_ramp(s))
 		return 1;
-	return s->time <= s->spec->gravity.ramp_time + 1e-9 * s->dt ? 2 : 0;
+	return by_ramp_end(s, s->time) ? 2 : 0;
 }
 
 /* Step 1: shape functions and gradients of soil and (double point) water points. */

@@ -13,9 +13,18 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
 #include <unistd.h>
 
 static int harness_failed_count;
+
+/* Monotonic wall-clock seconds, for the run times the verification tests print (never assert). */
+static inline double harness_wall_seconds(void)
+{
+	struct timespec ts;
+	clock_gettime(CLOCK_MONOTONIC, &ts);
+	return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
 
 /* Records one named check. */
 #define CHECK(cond, name, ...)                                                    \

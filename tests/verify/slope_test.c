@@ -19,7 +19,6 @@
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
-#include <time.h>
 
 #include "../harness.h"
 #include "case.h"
@@ -44,13 +43,6 @@ struct slope_run {
 	double oscillation[SNAPSHOTS];
 	double soil_mass_error, water_mass_error;
 };
-
-static double wall(void)
-{
-	struct timespec ts;
-	clock_gettime(CLOCK_MONOTONIC, &ts);
-	return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
 
 /* Mobilised soil: points displaced by more than one cell; the lowest initial height among them
  * marks how deep the failure reaches. */
@@ -87,7 +79,7 @@ static struct slope_run run_slope(const char *file, double h, int ppc, enum soil
 		case_destroy(&c);
 		return r;
 	}
-	const double soil0 = sim_soil_mass(s), water0 = sim_water_mass(s), t0 = wall();
+	const double soil0 = sim_soil_mass(s), water0 = sim_water_mass(s), t0 = harness_wall_seconds();
 	int next = 0;
 	while (r.ok && !sim_done(s)) {
 		r.ok = !sim_step(s);
@@ -98,7 +90,7 @@ static struct slope_run run_slope(const char *file, double h, int ppc, enum soil
 			next++;
 		}
 	}
-	r.seconds = wall() - t0;
+	r.seconds = harness_wall_seconds() - t0;
 	if (!r.ok && s && sim_error(s)->code)
 		printf("INFO %s failed at t = %.4f s: %s\n", file, sim_time(s), sim_error(s)->message);
 	r.settlement = -sim_probe_value(s, 0);

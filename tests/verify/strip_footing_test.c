@@ -19,7 +19,6 @@
  * h = 0.2 m run to the paper's t = 1 s (full load).
  */
 #include <stdlib.h>
-#include <time.h>
 
 #include "../harness.h"
 #include "case.h"
@@ -38,13 +37,6 @@ struct outcome {
 	double index, settlement, seconds;
 	int ok;
 };
-
-static double wall(void)
-{
-	struct timespec ts;
-	clock_gettime(CLOCK_MONOTONIC, &ts);
-	return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
 
 /* Runs `file` with the given stabilisation to `end`, on cells of h (dt scaled from the case's). */
 static struct outcome run(const char *file, enum soil_stabilisation kind, double end, double h)
@@ -66,10 +58,10 @@ static struct outcome run(const char *file, enum soil_stabilisation kind, double
 		case_destroy(&c);
 		return o;
 	}
-	double t0 = wall();
+	double t0 = harness_wall_seconds();
 	while (o.ok && !sim_done(s))
 		o.ok = !sim_step(s);
-	o.seconds = wall() - t0;
+	o.seconds = harness_wall_seconds() - t0;
 	if (!o.ok)
 		printf("INFO strip footing failed: %s\n", sim_error(s)->message);
 	o.settlement = -sim_probe_value(s, 0);   /* probe 0: vertical displacement under the centre */
