@@ -37,9 +37,11 @@
  * solved by Newton's method with backtracking, from the trial pressure, the old image pressure and
  * the q of the surface there. Borja and Andrade iterate on the elastic strains; ln p makes R0 linear
  * where ev makes p = exp(..) overshoot (kappa = 0.002), and es rather than dl as unknown keeps
- * q = 3 G es free of cancellation near liquefaction (q of a few Pa against 3 G of 1e8 Pa). When the smooth return would give es < 0 the stress goes to the tip of the surface
- * (q = 0, p = c_N pi, c_N = (1 - N)^(-(1 - N)/N), or e for N = 0), the whole deviatoric trial strain
- * being plastic (dl = es_tr); pi then solves R2 alone.
+ * q = 3 G es free of cancellation near liquefaction (q of a few Pa against 3 G of 1e8 Pa). When
+ * the smooth return fails or would give es < 0 the stress goes to the tip of the surface (q = 0,
+ * p = c_N pi, c_N = (1 - N)^(-(1 - N)/N), or e for N = 0), the whole deviatoric trial strain being
+ * plastic (dl = es_tr); pi then solves R2 alone. If that tip would lie above the trial pressure the
+ * stress stays at the trial pressure with q = 0 (a tension cut-off, tip_return()).
  *
  * 000 App. B.1:
  *   Eq. 92, dilatancy cut-off: with Ed = E_d^p after the step, psi_i is the usual value while
@@ -65,6 +67,11 @@
 #define NS_ITERATIONS_MAX 80
 #define NS_BACKTRACK_MAX 40
 #define NS_YIELD_TOLERANCE 1e-12  /* a trial with F <= this (p + q) is elastic */
+#define NS_BRACKET_SPAN 200.0     /* the tip return brackets its root within e^(+-200) of its junction */
+#define NS_BRACKET_ITERATIONS 200 /* safeguarded Newton: bisection alone needs ~60 from span 1 */
+
+/* Where a plastic return ends (tip_return). */
+enum { RETURN_SMOOTH, TIP_CORNER, TIP_TENSION };
 
 static const double SQRT_2_3 = 0.81649658092772603273;   /* sqrt(2/3) */
 
@@ -251,26 +258,87 @@ static int smooth_return(const struct ns_point *c, double x[3], int *iterations)
 	return norm <= NS_TOLERANCE ? 0 : -1;
 }
 
-/* The return to the tip: q = 0, dl = es_tr, p = c_N pi with pi from R2 alone. Fills pi and
- * dpi / d es_tr. -1 when the scalar Newton iteration fails. */
-static int tip_return(const struct ns_point *c, double *pi_out, double *dpi_des)
+/* The stress of the tip return for image pressure pi: the tip, p = c_N pi, while that is at most
+ * the trial pressure; above it the trial pressure itself (q = 0 inside the surface). */
+static double tip_pressure(const struct ns_point *c, double pi, double p_tr, double *dp_dpi)
+{
+	double cN = tip_ratio(c->n);
+	*dp_dpi = cN * pi <= p_tr ? cN : 0.0;
+	return fmin(cN * pi, p_tr);
+}
+
+/* The tip return's hardening residual R2 / pi as a function of y = ln pi (dl = es_tr, q = 0, p from
+ * tip_pressure):
+ *     r(y) = 1 - pi_n / pi - h dl (p g(psi_i) / pi - 1),
+ * with dr / dy in *dr. r rises with y: pi_n / pi falls, and p g / pi falls (p grows at most like pi,
+ * psi_i rises with pi so g falls, alpha <= 0); r -> 1 + h dl > 0 as pi -> inf, so a root exists.
+ * Returns -1 where psi_i is beyond the limit of the dilatancy (g undefined: r = -inf there). */
+static int tip_residual(const struct ns_point *c, double y, double p_tr, double *r, double *dr, double *g,
+			double *dg, double *psi_dl)
 {
 	const struct nor_sand_parameters *n = c->n;
-	double cN = tip_ratio(n), dl = c->es_tr, h = n->h, pi = c->pi_n;
-	for (int it = 0; it < NS_ITERATIONS_MAX; it++) {
-		double psi_pi, psi_dl, g, dg;
-		double psi = image_state(c, pi, dl, &psi_pi, &psi_dl);
-		if (limit_ratio(n, psi, &g, &dg))
+	double pi = exp(y), dl = c->es_tr, h = n->h, psi_pi, dp;
+	double psi = image_state(c, pi, dl, &psi_pi, psi_dl), p = tip_pressure(c, pi, p_tr, &dp);
+	if (limit_ratio(n, psi, g, dg))
+		return -1;
+	*r = 1.0 - c->pi_n / pi - h * dl * (p * *g / pi - 1.0);
+	*dr = c->pi_n / pi - h * dl * (dp * *g + p * *dg * psi_pi - p * *g / pi);
+	return 0;
+}
+
+/* The return to the tip: q = 0, dl = es_tr, pi from R2 alone, and p = c_N pi, or p = p_tr when the
+ * tip of the surface that satisfies R2 lies above the trial pressure. The tip is a corner of the
+ * surface; its plastic volume change is what the trial's elastic volume and p leave, and the flow
+ * rule there (D = -M / (1 - Nbar) at q = 0) is compaction, so the stress must end at p <= p_tr.
+ * When even the fully softened surface of the step has its tip above p_tr (a point pulled apart:
+ * a trial p of a few mPa under a shear of 0.8 MPa, image pressure 270 Pa, was met in a landslide),
+ * the stress stays at the trial's p with q = 0, inside the surface, and the image pressure
+ * softens by R2 with pi* = g p_tr: a tension cut-off, not in 000, written down in docs/numerics.md.
+ * Returns 1 for that branch, 0 for the tip, -1 when no root is found. Fills pi and dpi / d es_tr.
+ * The root is bracketed first, stepping down by factors of e from the junction pi = p_tr / c_N
+ * (or up from it), then found by Newton steps kept inside the bracket (bisection when a step leaves
+ * it). Plain Newton in pi from pi_n failed at a liquefied point (pi_n 0.13 Pa, trial q 0.5 MPa at
+ * p 23 Pa): h dl (c_N g - 1) > 1 at pi_n, the root lies six times above pi_n and the iteration ran
+ * to pi <= 0. */
+static int tip_return(const struct ns_point *c, double p_tr, double *pi_out, double *dpi_des)
+{
+	const struct nor_sand_parameters *n = c->n;
+	double dl = c->es_tr, h = n->h, g, dg, psi_dl, r, dr;
+	double mid = log(p_tr / tip_ratio(n)), lo = mid, hi = mid, y;
+	int bad = tip_residual(c, mid, p_tr, &r, &dr, &g, &dg, &psi_dl);
+	if (bad || r < 0.0) {
+		do
+			hi += 1.0;
+		while ((tip_residual(c, hi, p_tr, &r, &dr, &g, &dg, &psi_dl) || r < 0.0) && hi < mid + NS_BRACKET_SPAN);
+		if (r < 0.0)
 			return -1;
-		double p = cN * pi, R = pi - c->pi_n - h * dl * (p * g - pi);
-		double Rpi = 1.0 + h * dl - h * dl * cN * (g + pi * dg * psi_pi);
-		if (fabs(R) <= NS_TOLERANCE * c->pi_n) {
-			*pi_out = pi;
-			*dpi_des = (h * (p * g - pi) + h * dl * p * dg * psi_dl) / Rpi;
-			return 0;
+	} else {
+		do
+			lo -= 1.0;
+		while (tip_residual(c, lo, p_tr, &r, &dr, &g, &dg, &psi_dl) == 0 && r > 0.0 && lo > mid - NS_BRACKET_SPAN);
+		if (r > 0.0)
+			return -1;
+	}
+	y = 0.5 * (lo + hi);
+	for (int it = 0; it < NS_BRACKET_ITERATIONS; it++) {
+		if (tip_residual(c, y, p_tr, &r, &dr, &g, &dg, &psi_dl)) {
+			lo = y;
+			y = 0.5 * (lo + hi);
+			continue;
 		}
-		double next = pi - R / Rpi;
-		pi = next > 0.0 ? next : 0.5 * pi;
+		if (fabs(r) <= NS_TOLERANCE) {
+			double pi = exp(y), dp, p = tip_pressure(c, pi, p_tr, &dp);
+			*pi_out = pi;
+			/* dR2 / dpi = dr / dy at the root, since r = R2 / pi; p_tr does not move with es_tr */
+			*dpi_des = (h * (p * g - pi) + h * dl * p * dg * psi_dl) / dr;
+			return dp == 0.0;
+		}
+		if (r < 0.0)
+			lo = y;
+		else
+			hi = y;
+		double next = dr > 0.0 ? y - r / dr : 0.5 * (lo + hi);
+		y = next > lo && next < hi ? next : 0.5 * (lo + hi);
 	}
 	return -1;
 }
@@ -322,7 +390,13 @@ static void plastic_Ds(const struct ns_point *c, const double x[3], const double
 	double k = SQRT_2_3, ndev = c->es_tr / k, nv[3];
 	for (int a = 0; a < 3; a++)
 		nv[a] = ndev > 0.0 ? dev[a] / ndev : 0.0;
-	if (tip) {
+	if (tip == TIP_TENSION) {   /* p = p_tr: the elastic bulk response, q = 0 */
+		for (int a = 0; a < 3; a++)
+			for (int b = 0; b < 3; b++)
+				Ds[a][b] = exp(x[0]) / c->n->kappa;
+		return;
+	}
+	if (tip == TIP_CORNER) {
 		double dp = tip_ratio(c->n) * dpi_des;
 		for (int a = 0; a < 3; a++)
 			for (int b = 0; b < 3; b++)
@@ -455,19 +529,21 @@ enum poro_status nor_sand_update(const struct material *m, struct stress_update 
 		spectral_finish(u, finite, &t, s, t.e, 1, Ds);
 		x[0] = log(p_tr), x[1] = c.es_tr, x[2] = log(c.pi_n);
 	} else {
-		int iterations = 0, tip = 0;
+		int iterations = 0, tip = RETURN_SMOOTH;
 		/* start from the trial pressure, the old image pressure and the q of the surface there */
 		double q0 = q_tr - yield(n, p_tr, q_tr, c.pi_n, NULL, NULL);
 		x[0] = log(p_tr), x[1] = fmin(fmax(q0 / (3.0 * G), 0.0), c.es_tr), x[2] = log(c.pi_n);
 		if (smooth_return(&c, x, &iterations) || x[1] < 0.0)
-			tip = 1;
+			tip = TIP_CORNER;
 		double ratio, p, dpi_des = 0;
 		if (tip) {
-			if (tip_return(&c, &x[2], &dpi_des))
+			tip = tip_return(&c, p_tr, &x[2], &dpi_des);
+			if (tip < 0)
 				return poro_error_set(err, PORO_ESOLVER, "nor-sand: return mapping did not converge "
 						      "(trial p %.6g Pa, q %.6g Pa, image pressure %.6g Pa, v %.6g)",
 						      p_tr, q_tr, c.pi_n, v);
-			p = tip_ratio(n) * x[2];
+			p = tip == 1 ? p_tr : tip_ratio(n) * x[2];
+			tip = tip == 1 ? TIP_TENSION : TIP_CORNER;
 			x[0] = log(p), x[1] = 0.0, x[2] = log(x[2]);
 			ratio = 0.0;
 		} else {

