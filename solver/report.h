@@ -16,6 +16,10 @@
  * Definitions (h = the case's grid cell_size; "soil points" are the rows of a frame's soil set):
  *   toe_x        largest x of the soil points with y > ground + tolerance; NaN when there is none.
  *   runout       toe_x(t) - toe_x(first frame).
+ *   front_x      largest x of the soil points seeded above the ground, those whose reference
+ *                position y - displacement_y > ground + tolerance: the front of the soil that
+ *                came from the slope, blind to foundation soil heaved in front of the toe (which
+ *                toe_x counts); NaN when there is none.
  *   crest_settlement  s(first frame) - s(t), positive down, with s the surface height at x = crest:
  *                the largest y of the soil points with |x - crest| <= h/2; NaN when there is none.
  *   max_gap, max_gap_x  double point only (NaN in single point): the grid is cut into columns
@@ -79,6 +83,7 @@ struct report_row {
 	double time;                  /* s */
 	double toe_x;                 /* m */
 	double runout;                /* m */
+	double front_x;               /* m */
 	double crest_settlement;      /* m, positive down */
 	double max_gap;               /* m, soil surface above water surface */
 	double max_gap_x;             /* m, centre of the column of max_gap */

@@ -1,6 +1,6 @@
 /*
- * report_frames.c - the per-frame table of a report (report.h): toe and run-out, crest settlement,
- * the largest gap between the soil and water surfaces, and the oscillation index of the mean
+ * report_frames.c - the per-frame table of a report (report.h): toe, run-out and slide front, crest
+ * settlement, the largest gap between the soil and water surfaces, and the oscillation index of the mean
  * effective stress, from each frame's soil (and water) points. Definitions in report.h and
  * docs/report.md; each quantity is one pass over a frame's points.
  *
@@ -16,14 +16,15 @@
 #include "oscillation.h"
 #include "particles.h"
 
-/* Largest x of the points above `level`, NaN when none is. */
-static double toe(const double *x, long n, double level)
+/* Largest x of the points x[n] whose `at`[n] (their position, or their reference position) lies
+ * above `level`; NaN when none does. */
+static double front(const double *x, const double *at, long n, double level)
 {
-	double toe_x = -INFINITY;
+	double front_x = -INFINITY;
 	for (long i = 0; i < n; i++)
-		if (x[2 * i + 1] > level && x[2 * i] > toe_x)
-			toe_x = x[2 * i];
-	return isinf(toe_x) ? NAN : toe_x;
+		if (at[2 * i + 1] > level && x[2 * i] > front_x)
+			front_x = x[2 * i];
+	return isinf(front_x) ? NAN : front_x;
 }
 
 /* Surface height at `at`: the largest y of the points within `half` of it in x, NaN when none is. */
@@ -68,22 +69,35 @@ static void largest_gap(struct report *rep, const double *soil, long ns, const d
 	}
 }
 
-/* The oscillation index of the soil points x[n] of a frame; NaN where oscillation_index() finds it
- * undefined (PORO_EINVAL: zero stress, no point with two lattice neighbours). */
-static enum poro_status oscillation(struct report *rep, long frame, const double *x, long n, double *index,
+/* The reference positions x0 = x - displacement of the soil points x[n] of a frame (heap, the
+ * caller frees). */
+static enum poro_status reference_positions(struct report *rep, long frame, const double *x, long n, double **x0,
+					    struct poro_error *err)
+{
+	long rows = 0;
+	enum poro_status st = report_read(rep, frame, "soil", "displacement", 2, x0, &rows, err);
+	if (!st && rows != n)
+		st = poro_error_set(err, PORO_EIO, "frame %ld of '%s': %ld soil positions but %ld displacements",
+				    frame, rep->path, n, rows);
+	if (!st)
+		for (long k = 0; k < 2 * n; k++)
+			(*x0)[k] = x[k] - (*x0)[k];
+	return st;
+}
+
+/* The oscillation index of the soil points of a frame at reference positions x0[n]; NaN where
+ * oscillation_index() finds it undefined (PORO_EINVAL: zero stress, no point with two lattice
+ * neighbours). */
+static enum poro_status oscillation(struct report *rep, long frame, double *x0, long n, double *index,
 				    struct poro_error *err)
 {
-	double *x0 = NULL, *stress = NULL;
-	long rows_u = 0, rows_s = 0;
-	enum poro_status st = report_read(rep, frame, "soil", "displacement", 2, &x0, &rows_u, err);
-	if (!st)
-		st = report_read(rep, frame, "soil", "stress", 4, &stress, &rows_s, err);
-	if (!st && (rows_u != n || rows_s != n))
-		st = poro_error_set(err, PORO_EIO, "frame %ld of '%s': %ld soil positions but %ld displacements and "
-				    "%ld stresses", frame, rep->path, n, rows_u, rows_s);
+	double *stress = NULL;
+	long rows_s = 0;
+	enum poro_status st = report_read(rep, frame, "soil", "stress", 4, &stress, &rows_s, err);
+	if (!st && rows_s != n)
+		st = poro_error_set(err, PORO_EIO, "frame %ld of '%s': %ld soil positions but %ld stresses", frame,
+				    rep->path, n, rows_s);
 	if (!st) {
-		for (long k = 0; k < 2 * n; k++)
-			x0[k] = x[k] - x0[k];
 		const struct particles view = {.n = (idx_t)n, .x0 = x0, .stress = stress};
 		struct poro_error undefined = {0};
 		st = oscillation_index(&rep->spec->grid, &view, rep->spacing, index, &undefined);
@@ -92,7 +106,6 @@ static enum poro_status oscillation(struct report *rep, long frame, const double
 		else if (st)
 			*err = undefined;
 	}
-	free(x0);
 	free(stress);
 	return st;
 }
@@ -103,21 +116,25 @@ static enum poro_status frame_row(struct report *rep, long frame, struct report_
 				  struct poro_error *err)
 {
 	const struct report_settings *set = &rep->settings;
-	double *soil = NULL, *water = NULL;
+	double *soil = NULL, *soil0 = NULL, *water = NULL;
 	long ns = 0, nw = 0;
 	enum poro_status st = results_frame_time(rep->results, frame, &row->time, err);
 	if (!st)
 		st = report_read(rep, frame, "soil", "x", 2, &soil, &ns, err);
-	if (st)
-		return st;
-	row->toe_x = toe(soil, ns, set->ground + set->tolerance);
-	*top = surface(soil, ns, set->crest, REPORT_CREST_HALF_WIDTH * rep->h);
-	row->max_gap = row->max_gap_x = NAN;
-	if (rep->double_point && !(st = report_read(rep, frame, "water", "x", 2, &water, &nw, err)))
+	if (!st)
+		st = reference_positions(rep, frame, soil, ns, &soil0, err);
+	if (!st) {
+		row->toe_x = front(soil, soil, ns, set->ground + set->tolerance);
+		row->front_x = front(soil, soil0, ns, set->ground + set->tolerance);
+		*top = surface(soil, ns, set->crest, REPORT_CREST_HALF_WIDTH * rep->h);
+		row->max_gap = row->max_gap_x = NAN;
+	}
+	if (!st && rep->double_point && !(st = report_read(rep, frame, "water", "x", 2, &water, &nw, err)))
 		largest_gap(rep, soil, ns, water, nw, row);
 	if (!st)
-		st = oscillation(rep, frame, soil, ns, &row->oscillation_index, err);
+		st = oscillation(rep, frame, soil0, ns, &row->oscillation_index, err);
 	free(soil);
+	free(soil0);
 	free(water);
 	return st;
 }

@@ -187,9 +187,10 @@ static void check_rows(const struct report_row *r, long count, const double *dir
 {
 	char name[128];
 	const double toe[FRAMES] = {TOE0, TOE0 + DX, LIFTED_X, TOE0 + DX};
-	int toe_ok = count == FRAMES, settle_ok = toe_ok, time_ok = toe_ok;
+	int toe_ok = count == FRAMES, settle_ok = toe_ok, time_ok = toe_ok, front_ok = toe_ok;
 	for (long k = 0; toe_ok && k < FRAMES; k++) {
 		toe_ok &= near(r[k].toe_x, toe[k], TOL) && near(r[k].runout, toe[k] - TOE0, TOL);
+		front_ok &= near(r[k].front_x, k ? TOE0 + DX : TOE0, TOL);   /* the lifted point is foundation */
 		settle_ok &= near(r[k].crest_settlement, k ? DZ : 0.0, TOL);
 		time_ok &= r[k].time == k * FRAME_DT;
 	}
@@ -198,6 +199,9 @@ static void check_rows(const struct report_row *r, long count, const double *dir
 	snprintf(name, sizeof name, "%s_toe_and_runout_follow_imposed_slide_and_tolerance", label);
 	CHECK(toe_ok, name, "toe %.15g %.15g %.15g %.15g, want %.15g %.15g %.15g %.15g", r[0].toe_x, r[1].toe_x,
 	      r[2].toe_x, r[3].toe_x, toe[0], toe[1], toe[2], toe[3]);
+	snprintf(name, sizeof name, "%s_front_follows_slope_soil_not_lifted_foundation", label);
+	CHECK(front_ok, name, "front %.15g %.15g %.15g %.15g, want %.15g then %.15g", r[0].front_x, r[1].front_x,
+	      r[2].front_x, r[3].front_x, TOE0, TOE0 + DX);
 	snprintf(name, sizeof name, "%s_crest_settlement_is_imposed_settlement", label);
 	CHECK(settle_ok, name, "%.15g %.15g %.15g %.15g, want 0 then %g", r[0].crest_settlement,
 	      r[1].crest_settlement, r[2].crest_settlement, r[3].crest_settlement, DZ);
@@ -357,7 +361,7 @@ static void check_synthetic(const char *dir, const char *phases)
 	for (char *p = text; p && *p; p++)
 		lines += *p == '\n';
 	snprintf(name, sizeof name, "%s_csv_header_rows_and_nan", phases);
-	const char *head = "time,toe_x,runout,crest_settlement,max_gap,max_gap_x,oscillation_index\n0,1.975,0,0,";
+	const char *head = "time,toe_x,runout,front_x,crest_settlement,max_gap,max_gap_x,oscillation_index\n0,1.975,0,1.975,0,";
 	CHECK(!st && text && lines == FRAMES + 1 && !strncmp(text, head, strlen(head)) &&
 	      strstr(text, ",nan\n"), name, "status %d, %d lines:\n%s", st, lines, text ? text : "(unreadable)");
 	free(text);
