@@ -3,8 +3,8 @@
  * stepping and the read-only accessors of poro.h.
  *
  * Material points are seeded on a regular sub-grid: particles_per_cell^2 points per cell at the
- * centres of equal sub-cells, kept when inside the body (a point already inside an earlier body
- * belongs to that one). Each point gets the volume of its sub-cell. Double point seeds one water
+ * centres of equal sub-cells, kept when strictly inside the body (not on a polygon edge; a point
+ * already inside an earlier body belongs to that one). Each point gets the volume of its sub-cell. Double point seeds one water
  * point on every soil point (000 §5.1: "640 material points in total for both water and soil").
  */
 #include <math.h>
@@ -15,22 +15,40 @@
 #include "shape.h"
 #include "sim_internal.h"
 
-static int inside_polygon(const struct case_body *b, double x, double y)
+/* A seed point closer to a polygon edge than this many cell sizes lies on the edge: it is not
+ * inside. Seeds fall exactly on 45-degree faces whenever the face runs through sub-cell centres
+ * (the slopes of 000 §5.3 at 6x6 and 12x12 points per cell); round-off then decided each one,
+ * keeping 2 or 4 of them, where the paper's point counts (Table 4) keep none. */
+#define SEED_EDGE_TOLERANCE 1e-9
+
+/* Distance from (x, y) to the segment a-b. */
+static double segment_distance(const double *a, const double *b, double x, double y)
+{
+	double ex = b[0] - a[0], ey = b[1] - a[1], len2 = ex * ex + ey * ey;
+	double t = len2 > 0.0 ? ((x - a[0]) * ex + (y - a[1]) * ey) / len2 : 0.0;
+	t = fmin(fmax(t, 0.0), 1.0);
+	return hypot(x - a[0] - t * ex, y - a[1] - t * ey);
+}
+
+/* Strictly inside the polygon: crossing number, and not on an edge (within eps). */
+static int inside_polygon(const struct case_body *b, double x, double y, double eps)
 {
 	int inside = 0;
 	for (int i = 0, j = b->polygon_count - 1; i < b->polygon_count; j = i++) {
 		const double *pi = b->polygon[i], *pj = b->polygon[j];
+		if (segment_distance(pi, pj, x, y) <= eps)
+			return 0;
 		if ((pi[1] > y) != (pj[1] > y) && x < (pj[0] - pi[0]) * (y - pi[1]) / (pj[1] - pi[1]) + pi[0])
 			inside = !inside;
 	}
 	return inside;
 }
 
-static int inside_body(const struct case_body *b, double x, double y)
+static int inside_body(const struct case_body *b, double x, double y, double h)
 {
 	if (x < b->min[0] || x > b->max[0] || y < b->min[1] || y > b->max[1])
 		return 0;
-	return b->is_polygon ? inside_polygon(b, x, y) : 1;
+	return b->is_polygon ? inside_polygon(b, x, y, SEED_EDGE_TOLERANCE * h) : 1;
 }
 
 /* Visits every seed point: fills p when it is not NULL; returns the count. */
@@ -49,11 +67,11 @@ static idx_t seed_points(const struct sim *s, struct particles *p)
 					for (int si = 0; si < ppc; si++) {
 						double x = g->origin[0] + ci * g->h + (si + 0.5) * d;
 						double y = g->origin[1] + cj * g->h + (sj + 0.5) * d;
-						if (!inside_body(body, x, y))
+						if (!inside_body(body, x, y, g->h))
 							continue;
 						int taken = 0;
 						for (int e = 0; e < b && !taken; e++)
-							taken = inside_body(&c->bodies[e], x, y);
+							taken = inside_body(&c->bodies[e], x, y, g->h);
 						if (taken)
 							continue;
 						if (p) {
