@@ -25,6 +25,7 @@
 #include "oscillation.h"
 #include "particles.h"
 #include "poro.h"
+#include "slope_case.h"
 
 #define CASE_DIR "tests/cases/"
 #define PAPER_H 0.5                 /* m */
@@ -59,26 +60,21 @@ static void measure_failure(const struct particles *p, double h, struct slope_ru
 	}
 }
 
+static void set_stabilisation(struct case_spec *c, void *stabilisation)
+{
+	c->formulation.soil_stabilisation = *(enum soil_stabilisation *)stabilisation;
+}
+
 static struct slope_run run_slope(const char *file, double h, int ppc, enum soil_stabilisation stabilisation)
 {
 	struct slope_run r = {0};
 	struct case_spec *c = NULL;
 	struct sim *s = NULL;
 	struct poro_error err = {0};
-	r.ok = !case_load_file(file, &c, &err);
-	if (r.ok) {
-		c->time.dt *= h / c->grid.cell_size;   /* same CFL number */
-		c->grid.cell_size = h;
-		c->bodies[0].particles_per_cell = ppc;
-		c->formulation.soil_stabilisation = stabilisation;
-		r.dt = c->time.dt;
-		r.ok = !sim_create(&s, c, &err);
-	}
-	if (!r.ok) {
-		printf("INFO cannot run %s: %s\n", file, err.message);
-		case_destroy(&c);
+	r.ok = !slope_case_create(file, h, ppc, set_stabilisation, &stabilisation, &c, &s);
+	if (!r.ok)
 		return r;
-	}
+	r.dt = c->time.dt;
 	const double soil0 = sim_soil_mass(s), water0 = sim_water_mass(s), t0 = harness_wall_seconds();
 	int next = 0;
 	while (r.ok && !sim_done(s)) {

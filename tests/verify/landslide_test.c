@@ -1,0 +1,161 @@
+/*
+ * landslide_test.c - the Nor-Sand landslides of 000 §5.4 (Table 5, Figs. 9-10): dense (v0 = 1.55)
+ * and loose (v0 = 1.70) sand, double point against single point.
+ *
+ * Cases: tests/cases/landslide_{dense,loose}_{double,single}_point.json (geometry, initial state
+ * and the reading of psi's logarithm in docs/examples.md). Case time = paper time + 1 s (the
+ * elastic gravity ramp comes first).
+ *
+ * make test (reduced size): h = REDUCED_H with REDUCED_PPC^2 points per cell, dt scaled with h
+ * (the paper's CFL number), to the paper's 2 s.
+ * make verify (PORO_VERIFY_LONG=1): the paper's size, h = 0.025 m, 3x3 points per cell,
+ * dt = 1.2e-4 s, to the paper's 6 s (where the loose slide has come to rest, §5.4).
+ *
+ * Each run goes through sim_run() into a temporary result.h5 and is measured by the run report
+ * (solver/report.h), as a user measures it: the slide front (front_x: the farthest soil that
+ * started above the toe plain; the toe itself also counts foundation soil heaved in front of it)
+ * and the largest gap between the soil and water surfaces (double point), at the last frame.
+ * Asserted: every run reaches its end without the return mapping failing, soil mass (and water
+ * mass, double point) is conserved, the loose slope slides and its double- and single-point
+ * run-outs are close (Fig. 10), a gap opens in the dense double-point run and is wider than the
+ * loose one's (Figs. 9-10); the dense double-point run-out exceeding the single-point one (Fig. 9)
+ * is a known failure (docs/examples.md).
+ */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "../harness.h"
+#include "case.h"
+#include "poro.h"
+#include "report.h"
+#include "slope_case.h"
+
+#define CASE_DIR "tests/cases/"
+#define PAPER_H 0.025               /* m */
+#define PAPER_PPC 3
+#define REDUCED_H 0.05              /* m */
+#define REDUCED_PPC 2
+#define INITIALISATION 1.0          /* s: the gravity ramp before the paper's t = 0 */
+#define REDUCED_PAPER_END 2.0       /* s of the paper's time */
+#define FULL_PAPER_END 6.0
+#define MASS_TOLERANCE 1e-12        /* relative: points carry constant masses, outflow is booked */
+#define CLOSE_RUNOUT 0.2            /* Fig. 10's "similar": run-outs within 20% of the larger */
+
+struct landslide_run {
+	int ok;
+	double dt, runout, gap, settlement, seconds;
+	double soil_mass_error, water_mass_error;
+};
+
+/* The run report of out_dir/result.h5 at its last frame: run-out of the slide front, largest gap
+ * (NaN in single point) and crest settlement. */
+static int measure(const char *out_dir, struct landslide_run *r)
+{
+	char path[256];
+	struct report *rep = NULL;
+	struct report_settings set = REPORT_SETTINGS_DEFAULT;
+	struct report_row *rows = NULL;
+	struct poro_error err = {0};
+	long n = 0;
+	int ok = !report_open(&rep, harness_join(path, sizeof path, out_dir, "result.h5"), &set, &err) &&
+		 !report_frames(rep, &rows, &n, &err) && n > 1;
+	if (ok) {
+		r->runout = rows[n - 1].front_x - rows[0].front_x;
+		r->gap = rows[n - 1].max_gap;
+		r->settlement = rows[n - 1].crest_settlement;
+	} else {
+		printf("INFO cannot report %s: %s\n", path, err.message);
+	}
+	free(rows);
+	report_close(&rep);
+	return ok;
+}
+
+static void set_end(struct case_spec *c, void *paper_end)
+{
+	c->time.end = INITIALISATION + *(double *)paper_end;
+	c->checkpoint.interval = 0;
+}
+
+static struct landslide_run run_landslide(const char *file, double h, int ppc, double paper_end)
+{
+	struct landslide_run r = {0};
+	struct case_spec *c = NULL;
+	struct sim *s = NULL;
+	char *dir = harness_temp_dir("poro-landslide");
+	r.ok = dir && !slope_case_create(file, h, ppc, set_end, &paper_end, &c, &s);
+	if (!r.ok)
+		return r;
+	r.dt = c->time.dt;
+	const double soil0 = sim_soil_mass(s), water0 = sim_water_mass(s), t0 = harness_wall_seconds();
+	r.ok = !sim_run(s, dir, "test", NULL, NULL, NULL);
+	r.seconds = harness_wall_seconds() - t0;
+	if (!r.ok)
+		printf("INFO %s failed at t = %.4f s: %s\n", file, sim_time(s), sim_error(s)->message);
+	r.soil_mass_error = fabs(sim_soil_mass(s) - soil0) / soil0;
+	/* single point: the pores' water follows the soil's porosity and is exchanged through the
+	 * drained surface, so only the soil's mass is a point quantity (as in consolidation_test) */
+	r.water_mass_error = sim_is_double_point(s) ? fabs(sim_water_mass(s) + sim_water_outflow_mass(s) - water0) /
+				water0 : 0.0;
+	r.ok = r.ok && measure(dir, &r);
+	sim_destroy(&s);
+	case_destroy(&c);
+	harness_remove_dir(dir);
+	return r;
+}
+
+static void report(const char *label, double h, int ppc, const struct landslide_run *r)
+{
+	printf("INFO landslide %s h=%.3f m %dx%d dt=%.2e s: %s, front run-out %.4f m, crest settlement %.4f m, "
+	       "largest soil-water gap %.4f m, mass error soil %.1e water %.1e, run time %.1f s\n", label, h, ppc,
+	       ppc, r->dt, r->ok ? "ran to the end" : "FAILED", r->runout, r->settlement, r->gap,
+	       r->soil_mass_error, r->water_mass_error, r->seconds);
+}
+
+static void check_landslides(double h, int ppc, double paper_end, const char *size)
+{
+	static const char *const files[4] = {
+		CASE_DIR "landslide_dense_double_point.json", CASE_DIR "landslide_dense_single_point.json",
+		CASE_DIR "landslide_loose_double_point.json", CASE_DIR "landslide_loose_single_point.json",
+	};
+	static const char *const labels[4] = { "dense double point", "dense single point", "loose double point",
+					       "loose single point" };
+	struct landslide_run r[4];
+	int all_ok = 1;
+	double mass = 0;
+	for (int k = 0; k < 4; k++) {
+		r[k] = run_landslide(files[k], h, ppc, paper_end);
+		report(labels[k], h, ppc, &r[k]);
+		all_ok &= r[k].ok;
+		mass = fmax(mass, fmax(r[k].soil_mass_error, r[k].water_mass_error));
+	}
+	const struct landslide_run *dd = &r[0], *ds = &r[1], *ld = &r[2], *ls = &r[3];
+	char name[128];
+	snprintf(name, sizeof name, "landslide_%s_all_four_run_without_return_mapping_failure", size);
+	CHECK(all_ok, name, "dense %d/%d loose %d/%d (double/single)", dd->ok, ds->ok, ld->ok, ls->ok);
+	snprintf(name, sizeof name, "landslide_%s_mass_conserved", size);
+	CHECK(all_ok && mass < MASS_TOLERANCE, name, "largest relative mass error %.1e", mass);
+	snprintf(name, sizeof name, "landslide_%s_loose_slides", size);
+	CHECK(ld->ok && ls->ok && ld->runout > h && ls->runout > h, name,
+	      "front run-out double %.4f m single %.4f m, cell %.3f m", ld->runout, ls->runout, h);
+	snprintf(name, sizeof name, "landslide_%s_loose_double_and_single_close", size);
+	CHECK(ld->ok && ls->ok && fabs(ld->runout - ls->runout) <= CLOSE_RUNOUT * fmax(ld->runout, ls->runout), name,
+	      "front run-out double %.4f m single %.4f m (000 Fig. 10)", ld->runout, ls->runout);
+	snprintf(name, sizeof name, "landslide_%s_dense_double_point_gap_opens", size);
+	CHECK(dd->ok && ld->ok && dd->gap > h / ppc && dd->gap > ld->gap, name,
+	      "gap dense %.4f m loose %.4f m, seeding spacing %.4f m (000 Figs. 9-10)", dd->gap, ld->gap, h / ppc);
+	snprintf(name, sizeof name, "landslide_%s_dense_double_point_runs_out_farther", size);
+	/* Not reproduced (docs/examples.md): the dense slopes slide alike in both variants. */
+	CHECK_KNOWN_FAILURE(dd->ok && ds->ok && dd->runout > ds->runout + h, name,
+			    "front run-out double %.4f m single %.4f m (000 Fig. 9)", dd->runout, ds->runout);
+}
+
+int main(void)
+{
+	check_landslides(REDUCED_H, REDUCED_PPC, REDUCED_PAPER_END, "reduced");
+	const char *long_runs = getenv("PORO_VERIFY_LONG");
+	if (long_runs && *long_runs && strcmp(long_runs, "0") != 0)
+		check_landslides(PAPER_H, PAPER_PPC, FULL_PAPER_END, "paper_size");
+	HARNESS_EXIT();
+}
