@@ -294,7 +294,8 @@ static int tip_residual(const struct ns_point *c, double y, double p_tr, double 
  * a trial p of a few mPa under a shear of 0.8 MPa, image pressure 270 Pa, was met in a landslide),
  * the stress stays at the trial's p with q = 0, inside the surface, and the image pressure
  * softens by R2 with pi* = g p_tr: a tension cut-off, not in 000, written down in docs/numerics.md.
- * Returns 1 for that branch, 0 for the tip, -1 when no root is found. Fills pi and dpi / d es_tr.
+ * Returns TIP_TENSION for that branch, TIP_CORNER for the tip, -1 when no root is found. Fills pi
+ * and dpi / d es_tr.
  * The root is bracketed first, stepping down by factors of e from the junction pi = p_tr / c_N
  * (or up from it), then found by Newton steps kept inside the bracket (bisection when a step leaves
  * it). Plain Newton in pi from pi_n failed at a liquefied point (pi_n 0.13 Pa, trial q 0.5 MPa at
@@ -305,18 +306,21 @@ static int tip_return(const struct ns_point *c, double p_tr, double *pi_out, dou
 	const struct nor_sand_parameters *n = c->n;
 	double dl = c->es_tr, h = n->h, g, dg, psi_dl, r, dr;
 	double mid = log(p_tr / tip_ratio(n)), lo = mid, hi = mid, y;
-	int bad = tip_residual(c, mid, p_tr, &r, &dr, &g, &dg, &psi_dl);
-	if (bad || r < 0.0) {
+	/* below: residual undefined (psi_i past the dilatancy limit) counts as r < 0 */
+	int below = tip_residual(c, mid, p_tr, &r, &dr, &g, &dg, &psi_dl) || r < 0.0;
+	if (below) {
 		do
 			hi += 1.0;
-		while ((tip_residual(c, hi, p_tr, &r, &dr, &g, &dg, &psi_dl) || r < 0.0) && hi < mid + NS_BRACKET_SPAN);
-		if (r < 0.0)
+		while ((below = tip_residual(c, hi, p_tr, &r, &dr, &g, &dg, &psi_dl) || r < 0.0) &&
+		       hi < mid + NS_BRACKET_SPAN);
+		if (below)
 			return -1;
 	} else {
 		do
 			lo -= 1.0;
-		while (tip_residual(c, lo, p_tr, &r, &dr, &g, &dg, &psi_dl) == 0 && r > 0.0 && lo > mid - NS_BRACKET_SPAN);
-		if (r > 0.0)
+		while (!(below = tip_residual(c, lo, p_tr, &r, &dr, &g, &dg, &psi_dl) || r < 0.0) &&
+		       lo > mid - NS_BRACKET_SPAN);
+		if (!below)
 			return -1;
 	}
 	y = 0.5 * (lo + hi);
@@ -331,7 +335,7 @@ static int tip_return(const struct ns_point *c, double p_tr, double *pi_out, dou
 			*pi_out = pi;
 			/* dR2 / dpi = dr / dy at the root, since r = R2 / pi; p_tr does not move with es_tr */
 			*dpi_des = (h * (p * g - pi) + h * dl * p * dg * psi_dl) / dr;
-			return dp == 0.0;
+			return dp == 0.0 ? TIP_TENSION : TIP_CORNER;
 		}
 		if (r < 0.0)
 			lo = y;
@@ -542,8 +546,8 @@ enum poro_status nor_sand_update(const struct material *m, struct stress_update 
 				return poro_error_set(err, PORO_ESOLVER, "nor-sand: return mapping did not converge "
 						      "(trial p %.6g Pa, q %.6g Pa, image pressure %.6g Pa, v %.6g)",
 						      p_tr, q_tr, c.pi_n, v);
-			p = tip == 1 ? p_tr : tip_ratio(n) * x[2];
-			tip = tip == 1 ? TIP_TENSION : TIP_CORNER;
+			double dp_dpi;
+			p = tip_pressure(&c, x[2], p_tr, &dp_dpi);
 			x[0] = log(p), x[1] = 0.0, x[2] = log(x[2]);
 			ratio = 0.0;
 		} else {

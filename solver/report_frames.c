@@ -1,7 +1,7 @@
 /*
- * report_frames.c - the per-frame table of a report (report.h): toe, run-out and slide front, crest
- * settlement, the largest gap between the soil and water surfaces, and the oscillation index of the mean
- * effective stress, from each frame's soil (and water) points. Definitions in report.h and
+ * report_frames.c - the per-frame table of a report (report.h): toe, run-out and slide front,
+ * crest settlement, the largest gap between the soil and water surfaces, and the oscillation index
+ * of the mean effective stress, from each frame's soil (and water) points. Definitions in report.h and
  * docs/report.md; each quantity is one pass over a frame's points.
  *
  * The oscillation index is oscillation_index() itself (oscillation.h), given a read-only view of

@@ -4,8 +4,9 @@
  *
  * Material points are seeded on a regular sub-grid: particles_per_cell^2 points per cell at the
  * centres of equal sub-cells, kept when strictly inside the body (not on a polygon edge; a point
- * already inside an earlier body belongs to that one). Each point gets the volume of its sub-cell. Double point seeds one water
- * point on every soil point (000 §5.1: "640 material points in total for both water and soil").
+ * already inside an earlier body belongs to that one). Each point gets the volume of its sub-cell.
+ * Double point seeds one water point on every soil point (000 §5.1: "640 material points in total
+ * for both water and soil").
  */
 #include <math.h>
 #include <stdlib.h>
@@ -17,8 +18,8 @@
 
 /* A seed point closer to a polygon edge than this many cell sizes lies on the edge: it is not
  * inside. Seeds fall exactly on 45-degree faces whenever the face runs through sub-cell centres
- * (the slopes of 000 §5.3 at 6x6 and 12x12 points per cell); round-off then decided each one,
- * keeping 2 or 4 of them, where the paper's point counts (Table 4) keep none. */
+ * (the slopes of 000 §5.3 at 6x6 to 24x24 points per cell); round-off then decided each one,
+ * keeping 0 to 8 of them, where the paper's point counts (Table 4) keep none. */
 #define SEED_EDGE_TOLERANCE 1e-9
 
 /* Distance from (x, y) to the segment a-b. */
