@@ -9,7 +9,7 @@
  *                                        single-element triaxial test (element.h, docs/element.md):
  *                                        DIR/element.csv and DIR/element.svg
  *   poro-solve report RESULT.h5 [--out FILE] [--ground Y] [--crest X] [--tolerance M]
- *                     [--line X0,Y0,X1,Y1[,N] --line-out FILE [--at TIME]]
+ *                     [--line X0,Y0,X1,Y1[,...][,N] --line-out FILE [--at TIME]]
  *                                        derived quantities of a run (report.h, docs/report.md): a
  *                                        CSV row per frame (toe, run-out, crest settlement, soil-water
  *                                        gap, oscillation index) to stdout or FILE, and the pore
@@ -58,7 +58,7 @@ static int usage(void)
 			"       poro-solve validate CASE.json\n"
 			"       poro-solve element CASE.json --out DIR\n"
 			"       poro-solve report RESULT.h5 [--out FILE] [--ground Y] [--crest X] [--tolerance M]\n"
-			"                         [--line X0,Y0,X1,Y1[,N] --line-out FILE [--at TIME]]\n"
+			"                         [--line X0,Y0,X1,Y1[,...][,N] --line-out FILE [--at TIME]]\n"
 			"       poro-solve version\n");
 	return 2;
 }
@@ -208,7 +208,7 @@ static int parse_run(int argc, char **argv)
 /* What `report` was asked for besides the result file. */
 struct report_options {
 	const char *out;            /* the per-frame table, or NULL for stdout */
-	const char *line;           /* "X0,Y0,X1,Y1[,N]", or NULL for no line */
+	const char *line;           /* "X0,Y0,X1,Y1[,...][,N]", or NULL for no line */
 	const char *line_out;       /* the line table */
 	double at;                  /* s, NAN = the last frame */
 	struct report_settings settings;

@@ -33,7 +33,8 @@
  *                before gravity acts, or no point with two lattice neighbours).
  *   line sample  the mean pore pressure of the points that carry it (water points in double
  *                point, soil points in single point) within distance h of the sample; NaN when
- *                none is.
+ *                none is. A line is a polyline (a curved shear band is followed corner by
+ *                corner), its samples evenly spaced along its length.
  *
  * Defaults derived from the case stored in the file (struct report_settings, field NAN): they need
  * every body to be a polygon (the slope of tests/cases/mc_slope_*.json and landslide_*.json);
@@ -67,6 +68,7 @@
 #define REPORT_LINE_RADIUS 1.0         /* radius a line sample averages over, in cells */
 #define REPORT_LINE_SAMPLES 50         /* samples along a line when not given */
 #define REPORT_LINE_SAMPLES_MAX 100000
+#define REPORT_LINE_VERTICES_MAX 64    /* corners of a sampled path: enough to follow a curved shear band */
 #define REPORT_TOLERANCE_SPACINGS 0.25 /* default tolerance, in finest seeding spacings */
 #define REPORT_TIME_SLACK 1e-9         /* a time may lie outside the frames by this much of the run's span */
 
@@ -90,14 +92,16 @@ struct report_row {
 	double oscillation_index;     /* 1 */
 };
 
-/* A line to sample: `samples` points evenly spaced from `from` to `to`, both ends included. */
+/* A path to sample: the polyline through `vertices` corners, with `samples` points evenly spaced
+ * along its length, both ends included (a straight line is the path of two corners). */
 struct report_line {
-	double from[2], to[2];        /* m */
+	double vertex[REPORT_LINE_VERTICES_MAX][2];  /* m, the corners in order */
+	int vertices;                 /* 2 .. REPORT_LINE_VERTICES_MAX */
 	int samples;                  /* 2 .. REPORT_LINE_SAMPLES_MAX */
 };
 
 struct report_sample {
-	double distance;              /* m along the line from `from` */
+	double distance;              /* m along the path from its first corner */
 	double x, y;                  /* m */
 	double pore_pressure;         /* Pa, positive in compression; NAN when no point is in reach */
 	int points;                   /* points averaged */
@@ -119,8 +123,10 @@ const struct report_settings *report_settings_used(const struct report *rep);
 /* Computes one row per frame into *rows (malloc'd, *count = the frame count). */
 enum poro_status report_frames(struct report *rep, struct report_row **rows, long *count, struct poro_error *err);
 
-/* Parses "x0,y0,x1,y1" or "x0,y0,x1,y1,n" (n defaults to REPORT_LINE_SAMPLES): finite numbers,
- * distinct ends, n an integer in range. PORO_EINVAL naming the text and what is wrong. */
+/* Parses "x0,y0,x1,y1[,x2,y2 ...][,n]": an even count of numbers is the corners alone (n defaults
+ * to REPORT_LINE_SAMPLES), an odd count ends with n. Finite numbers, 2 to REPORT_LINE_VERTICES_MAX
+ * corners, no corner equal to the one before it, n an integer in range. PORO_EINVAL naming the text
+ * and what is wrong. */
 enum poro_status report_line_parse(const char *text, struct report_line *line, struct poro_error *err);
 
 /* Samples the pore pressure along line at the frame nearest to time `at` (NAN: the last frame;

@@ -1,6 +1,7 @@
 /*
- * report_line.c - the pore pressure along a line at one frame (report.h): the line parsed from
- * "x0,y0,x1,y1[,n]", the frame nearest the asked time, and at each of n evenly spaced samples the
+ * report_line.c - the pore pressure along a path at one frame (report.h): the path parsed from
+ * "x0,y0,x1,y1[,x2,y2 ...][,n]" (a polyline, so that a curved shear band can be followed), the
+ * frame nearest the asked time, and at each of n samples evenly spaced along the path's length the
  * mean pore pressure of the points that carry it (water points in double point, soil points in
  * single point) within REPORT_LINE_RADIUS cells. The points are searched by brute force, n times
  * N distance tests: a report is run once, and 50 samples over the 20,000 points of the paper's
@@ -10,13 +11,14 @@
 
 #include <stdlib.h>
 
-#define LINE_NUMBERS_MAX 5   /* x0, y0, x1, y1, n */
+#define LINE_NUMBERS_MAX (2 * REPORT_LINE_VERTICES_MAX + 1)   /* the corners, then n */
 
 /* ---- parsing ----------------------------------------------------------------------------------- */
 
 static enum poro_status malformed(const char *text, const char *why, struct poro_error *err)
 {
-	return poro_error_set(err, PORO_EINVAL, "malformed line '%s': %s; expected x0,y0,x1,y1[,n]", text, why);
+	return poro_error_set(err, PORO_EINVAL, "malformed line '%s': %s; expected x0,y0,x1,y1[,x2,y2 ...][,n]",
+			      text, why);
 }
 
 enum poro_status report_line_parse(const char *text, struct report_line *line, struct poro_error *err)
@@ -27,7 +29,8 @@ enum poro_status report_line_parse(const char *text, struct report_line *line, s
 	for (const char *p = text;; count++) {
 		char *end;
 		if (count == LINE_NUMBERS_MAX)
-			return malformed(text, "more than 5 numbers", err);
+			return poro_error_set(err, PORO_EINVAL, "line '%s': more than %d corners", text,
+					      REPORT_LINE_VERTICES_MAX);
 		v[count] = strtod(p, &end);
 		if (end == p || !isfinite(v[count]))
 			return malformed(text, "an item is not a finite number", err);
@@ -41,13 +44,20 @@ enum poro_status report_line_parse(const char *text, struct report_line *line, s
 	}
 	if (count < 4)
 		return malformed(text, "fewer than 4 numbers", err);
-	double n = count == 5 ? v[4] : REPORT_LINE_SAMPLES;
+	/* An odd count ends with n; "x0,y0,x1,y1,n" keeps the meaning it had for a straight line. */
+	double n = count % 2 ? v[count - 1] : REPORT_LINE_SAMPLES;
 	if (n != floor(n) || n < 2 || n > REPORT_LINE_SAMPLES_MAX)
 		return poro_error_set(err, PORO_EINVAL, "line '%s': n = %g samples, expected an integer from 2 to %d",
 				      text, n, REPORT_LINE_SAMPLES_MAX);
-	if (v[0] == v[2] && v[1] == v[3])
-		return poro_error_set(err, PORO_EINVAL, "line '%s': its two ends coincide", text);
-	*line = (struct report_line){.from = {v[0], v[1]}, .to = {v[2], v[3]}, .samples = (int)n};
+	line->vertices = count / 2;
+	line->samples = (int)n;
+	for (int c = 0; c < line->vertices; c++) {
+		line->vertex[c][0] = v[2 * c];
+		line->vertex[c][1] = v[2 * c + 1];
+		if (c > 0 && v[2 * c] == v[2 * c - 2] && v[2 * c + 1] == v[2 * c - 1])
+			return poro_error_set(err, PORO_EINVAL, "line '%s': corner %d coincides with corner %d", text,
+					      c + 1, c);
+	}
 	return PORO_OK;
 }
 
@@ -95,6 +105,35 @@ static void sample_at(const double *x, const double *p, long n, double r, struct
 	s->pore_pressure = s->points ? sum / s->points : NAN;
 }
 
+/* Length of the polyline, m. */
+static double path_length(const struct report_line *line)
+{
+	double length = 0.0;
+	for (int c = 1; c < line->vertices; c++)
+		length += hypot(line->vertex[c][0] - line->vertex[c - 1][0], line->vertex[c][1] - line->vertex[c - 1][1]);
+	return length;
+}
+
+/* Puts sample s at distance d along the path: on the segment where the corners' running length
+ * passes d (the last corner exactly at the full length, whatever the round-off of the sum). */
+static void place_sample(const struct report_line *line, double d, struct report_sample *s)
+{
+	const double (*v)[2] = line->vertex;
+	int last = line->vertices - 1;
+	double start = 0.0;
+	s->distance = d;
+	for (int c = 1; c <= last; c++) {
+		double length = hypot(v[c][0] - v[c - 1][0], v[c][1] - v[c - 1][1]);
+		if (d <= start + length || c == last) {
+			double f = fmin(fmax((d - start) / length, 0.0), 1.0);
+			s->x = v[c - 1][0] + f * (v[c][0] - v[c - 1][0]);
+			s->y = v[c - 1][1] + f * (v[c][1] - v[c - 1][1]);
+			return;
+		}
+		start += length;
+	}
+}
+
 enum poro_status report_line_sample(struct report *rep, const struct report_line *line, double at,
 				    struct report_sample **out, double *frame_time, struct poro_error *err)
 {
@@ -113,12 +152,8 @@ enum poro_status report_line_sample(struct report *rep, const struct report_line
 	struct report_sample *s = st ? NULL : malloc(sizeof *s * (size_t)line->samples);
 	if (!st && !s)
 		st = poro_error_set(err, PORO_ENOMEM, "cannot allocate %d line samples", line->samples);
-	const double dx = line->to[0] - line->from[0], dy = line->to[1] - line->from[1];
 	for (int k = 0; !st && k < line->samples; k++) {
-		double f = (double)k / (line->samples - 1);
-		s[k].distance = f * hypot(dx, dy);
-		s[k].x = line->from[0] + f * dx;
-		s[k].y = line->from[1] + f * dy;
+		place_sample(line, path_length(line) * k / (line->samples - 1), &s[k]);
 		sample_at(x, p, n, REPORT_LINE_RADIUS * rep->h, &s[k]);
 	}
 	free(x);

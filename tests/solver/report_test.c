@@ -304,6 +304,22 @@ static void check_line(struct report *rep, const char *path, const char *carrier
 	snprintf(name, sizeof name, "%s_line_at_nearest_frame_earlier_on_tie_last_by_default", label);
 	CHECK(ok, name, "status %d: %s", st, st ? err.message : "");
 
+	/* a polyline: up x = 0.5 by 0.4 m, then along y = 0.625 by 0.8 m; 13 samples every 0.1 m, the
+	 * fifth on the corner */
+	s = sample(rep, "0.5,0.225,0.5,0.625,1.3,0.625,13", 0.0, &t, &n, &st, &err);
+	ok = !st && n == 13;
+	counted = 1;
+	for (int k = 0; ok && k < n; k++) {
+		double want_x = k <= 4 ? 0.5 : 0.5 + 0.1 * (k - 4), want_y = k <= 4 ? 0.225 + 0.1 * k : 0.625;
+		ok &= near(s[k].distance, 0.1 * k, TOL) && near(s[k].x, want_x, TOL) && near(s[k].y, want_y, TOL);
+		counted &= s[k].points == points_within(path, 0, carrier, s[k].x, s[k].y);
+	}
+	ok &= !st && s[4].x == 0.5 && s[4].y == 0.625 && s[12].x == 1.3 && s[12].y == 0.625;
+	snprintf(name, sizeof name, "%s_polyline_samples_evenly_along_its_length_through_the_corner", label);
+	CHECK(ok && counted, name, "status %d (%s), %d samples, counts %s", st, st ? err.message : "", n,
+	      counted ? "agree" : "differ from brute force");
+	free(s);
+
 	s = sample(rep, "2.9,1.5,2.95,1.55,2", 0.0, &t, &n, &st, &err);
 	ok = !st && n == 2 && isnan(s[0].pore_pressure) && s[0].points == 0 && isnan(s[1].pore_pressure);
 	snprintf(name, sizeof name, "%s_line_sample_without_points_is_nan", label);
@@ -417,7 +433,7 @@ static void check_errors(const char *dir, const char *polygon_dir)
 	}
 	CHECK(refused == 3, "negative_tolerance_and_infinite_settings_refused", "%d of 3 refused", refused);
 
-	const char *malformed[] = {"", "1,2,3", "1,2,3,4,5,6", "1,2,x,4", "1;2;3;4", "1,2,3,4,1", "1,2,3,4,2.5",
+	const char *malformed[] = {"", "1,2,3", "1,2,3,4,3,4", "1,2,3,4,5,6,5,6,9", "1,2,x,4", "1;2;3;4", "1,2,3,4,1", "1,2,3,4,2.5",
 				   "1,2,3,4,1e9", "1,2,1,2", "1,2,3,4,", "nan,2,3,4", "1,2,3,inf"};
 	struct report_line line;
 	int n_bad = (int)(sizeof malformed / sizeof *malformed);
@@ -429,9 +445,24 @@ static void check_errors(const char *dir, const char *polygon_dir)
 		CHECK(st == PORO_EINVAL && strstr(err.message, quoted), name, "status %d: %s", st, err.message);
 	}
 	st = report_line_parse(" 1.5,-2e-1,3,4.25", &line, &err);
-	CHECK(!st && line.from[0] == 1.5 && line.from[1] == -0.2 && line.to[0] == 3 && line.to[1] == 4.25 &&
+	CHECK(!st && line.vertices == 2 && line.vertex[0][0] == 1.5 && line.vertex[0][1] == -0.2 &&
+	      line.vertex[1][0] == 3 && line.vertex[1][1] == 4.25 &&
 	      line.samples == REPORT_LINE_SAMPLES, "line_parse_four_numbers_default_samples", "status %d: %s", st,
 	      err.message);
+	char corners[2048] = "";
+	for (int c = 0; c <= REPORT_LINE_VERTICES_MAX; c++)   /* one corner too many */
+		snprintf(corners + strlen(corners), sizeof corners - strlen(corners), "%s%d,%d", c ? "," : "", c, c);
+	st = report_line_parse(corners, &line, &err);
+	CHECK(st == PORO_EINVAL && strstr(err.message, "more than 64 corners"), "line_parse_refuses_too_many_corners",
+	      "status %d: %s", st, err.message);
+	corners[strlen(corners) - strlen(",64,64")] = 0;
+	st = report_line_parse(corners, &line, &err);
+	CHECK(!st && line.vertices == REPORT_LINE_VERTICES_MAX && line.vertex[63][1] == 63 &&
+	      line.samples == REPORT_LINE_SAMPLES, "line_parse_takes_64_corners", "status %d: %s", st, err.message);
+	st = report_line_parse("0,0,1,0,1,2", &line, &err);
+	CHECK(!st && line.vertices == 3 && line.vertex[2][1] == 2 && line.samples == REPORT_LINE_SAMPLES,
+	      "line_parse_even_count_is_corners_only", "status %d, %d corners, %d samples", st, line.vertices,
+	      line.samples);
 	st = report_line_parse("0,0,1,0,7", &line, &err);
 	CHECK(!st && line.samples == 7, "line_parse_samples", "status %d, %d samples", st, line.samples);
 }
