@@ -136,6 +136,13 @@ enum poro_status report_line_parse(const char *text, struct report_line *line, s
 enum poro_status report_line_sample(struct report *rep, const struct report_line *line, double at,
 				    struct report_sample **samples, double *frame_time, struct poro_error *err);
 
+/* The sampling itself, on points of one's own: line->samples samples into samples[], each the mean
+ * of p over the n points x[2n] within `radius` (m) of it (report_line_sample passes the frame's
+ * carriers and REPORT_LINE_RADIUS cells). For a caller that holds the points, such as a test
+ * stepping a simulation; p in whatever sign the caller keeps. */
+void report_line_sample_points(const struct report_line *line, const double *x, const double *p, long n,
+				double radius, struct report_sample *samples);
+
 /* Write the rows, or the samples, as CSV with a header line ("nan" for NaN) to f; `name` names f
  * in the PORO_EIO message when writing fails. */
 enum poro_status report_frames_write(FILE *f, const char *name, const struct report_row *rows, long count,

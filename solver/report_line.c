@@ -134,6 +134,16 @@ static void place_sample(const struct report_line *line, double d, struct report
 	}
 }
 
+void report_line_sample_points(const struct report_line *line, const double *x, const double *p, long n,
+				double radius, struct report_sample *samples)
+{
+	const double length = path_length(line);
+	for (int k = 0; k < line->samples; k++) {
+		place_sample(line, length * k / (line->samples - 1), &samples[k]);
+		sample_at(x, p, n, radius, &samples[k]);
+	}
+}
+
 enum poro_status report_line_sample(struct report *rep, const struct report_line *line, double at,
 				    struct report_sample **out, double *frame_time, struct poro_error *err)
 {
@@ -152,10 +162,8 @@ enum poro_status report_line_sample(struct report *rep, const struct report_line
 	struct report_sample *s = st ? NULL : malloc(sizeof *s * (size_t)line->samples);
 	if (!st && !s)
 		st = poro_error_set(err, PORO_ENOMEM, "cannot allocate %d line samples", line->samples);
-	for (int k = 0; !st && k < line->samples; k++) {
-		place_sample(line, path_length(line) * k / (line->samples - 1), &s[k]);
-		sample_at(x, p, n, REPORT_LINE_RADIUS * rep->h, &s[k]);
-	}
+	if (!st)
+		report_line_sample_points(line, x, p, n, REPORT_LINE_RADIUS * rep->h, s);
 	free(x);
 	free(p);
 	if (st)

@@ -14,7 +14,10 @@
  * Measured per run: crest settlement (probe 0 of the cases: the soil point nearest the crest
  * edge), the points mobilised (displacement above one cell) and the lowest initial height among
  * them (the depth of the failure), the oscillation index of the mean effective stress
- * (solver/oscillation.h) at the paper's 2, 4 and 6 s, and the mass balance of both phases.
+ * (solver/oscillation.h) at the paper's 2, 4 and 6 s, the pore pressure along the lower shear
+ * band at the paper's 3 s (Fig. 5b, sampled as `poro-solve report --line` does), the largest
+ * relative displacement of a water point from the soil point it started on (§5.3: 0.0014 m at
+ * k = 1e-7 and 0.0065 m at k = 1e-3 m/s), and the mass balance of both phases.
  */
 #include <math.h>
 #include <stdlib.h>
@@ -25,6 +28,7 @@
 #include "oscillation.h"
 #include "particles.h"
 #include "poro.h"
+#include "report.h"
 #include "slope_case.h"
 
 #define CASE_DIR "tests/cases/"
@@ -36,6 +40,15 @@
 #define SNAPSHOTS 3
 static const double snapshot_paper_time[SNAPSHOTS] = {2.0, 4.0, 6.0};   /* 000 Fig. 7 */
 
+/* 000 Fig. 5b: the lower shear band, which Yuan et al. define and 000 only sketches in Fig. 5a.
+ * Here the ridge of accumulated plastic strain of the full-size k = 1e-3 double-point run at the
+ * paper's 3 s, traced row by row and column by column (docs/examples.md): from behind the crest
+ * down into the foundation's top and out at the toe, 17.3 m long, 41 samples. */
+#define BAND "8.9,14.25,9.6,11.5,10.4,9.75,11.4,7.5,12.4,6.25,13.6,5.1,14.75,4.4,16.5,4.0,18.25,4.5,20,5.0,41"
+#define BAND_SAMPLES 41
+#define BAND_PAPER_TIME 3.0         /* s */
+#define BAND_PRINT_EVERY 5          /* samples between two printed on the INFO line */
+
 struct slope_run {
 	int ok;
 	long steps;
@@ -43,6 +56,9 @@ struct slope_run {
 	long mobilised;
 	double oscillation[SNAPSHOTS];
 	double soil_mass_error, water_mass_error;
+	struct report_sample band[BAND_SAMPLES];   /* pore pressure, Pa, compression positive */
+	int band_sampled;
+	double relative_displacement;              /* m, largest over the point pairs; NAN if unpaired */
 };
 
 /* Mobilised soil: points displaced by more than one cell; the lowest initial height among them
@@ -58,6 +74,48 @@ static void measure_failure(const struct particles *p, double h, struct slope_ru
 			r->lowest_mobilised = fmin(r->lowest_mobilised, p->x0[2 * q + 1]);
 		}
 	}
+}
+
+/* The band's pore pressure from the points that carry it (water in double point), compression
+ * positive as in result.h5, averaged within one cell of each sample (REPORT_LINE_RADIUS). */
+static int sample_band(const struct sim *s, double h, struct slope_run *r)
+{
+	const struct particles *w = sim_water(s);
+	struct report_line band;
+	struct poro_error err = {0};
+	double *p = malloc(sizeof *p * ((size_t)w->n + 1));
+	int ok = p && !report_line_parse(BAND, &band, &err) && band.samples == BAND_SAMPLES;
+	for (idx_t q = 0; ok && q < w->n; q++)
+		p[q] = -w->pressure[q];
+	if (ok)
+		report_line_sample_points(&band, w->x, p, w->n, REPORT_LINE_RADIUS * h, r->band);
+	free(p);
+	return ok;
+}
+
+/* Water points start on soil points, in the same order, and stay attached through the gravity
+ * ramp (docs/examples.md): offset[] holds each pair's separation at the ramp's end, and the
+ * relative displacement is how far a pair has moved apart since. NAN when the sets do not pair
+ * (single point, or water points have left). */
+static double relative_displacement(const struct sim *s, const double *offset)
+{
+	const struct particles *p = sim_soil(s), *w = sim_water(s);
+	if (!offset || w->n != p->n || w->x == p->x)
+		return NAN;
+	double largest = 0.0;
+	for (idx_t q = 0; q < p->n; q++)
+		largest = fmax(largest, hypot(p->x[2 * q] - w->x[2 * q] - offset[2 * q],
+					      p->x[2 * q + 1] - w->x[2 * q + 1] - offset[2 * q + 1]));
+	return largest;
+}
+
+static double *pair_offsets(const struct sim *s)
+{
+	const struct particles *p = sim_soil(s), *w = sim_water(s);
+	double *offset = w->n == p->n ? malloc(sizeof *offset * 2 * ((size_t)p->n + 1)) : NULL;
+	for (idx_t k = 0; offset && k < 2 * p->n; k++)
+		offset[k] = p->x[k] - w->x[k];
+	return offset;
 }
 
 static void set_stabilisation(struct case_spec *c, void *stabilisation)
@@ -76,10 +134,15 @@ static struct slope_run run_slope(const char *file, double h, int ppc, enum soil
 		return r;
 	r.dt = c->time.dt;
 	const double soil0 = sim_soil_mass(s), water0 = sim_water_mass(s), t0 = harness_wall_seconds();
+	double *offset = NULL;
 	int next = 0;
 	while (r.ok && !sim_done(s)) {
 		r.ok = !sim_step(s);
 		r.steps++;
+		if (r.ok && !offset && sim_time(s) >= INITIALISATION - 0.5 * r.dt)
+			offset = pair_offsets(s);
+		if (r.ok && !r.band_sampled && sim_time(s) >= INITIALISATION + BAND_PAPER_TIME - 0.5 * r.dt)
+			r.band_sampled = sample_band(s, h, &r);
 		if (r.ok && next < SNAPSHOTS && sim_time(s) >= INITIALISATION + snapshot_paper_time[next] - 0.5 * r.dt) {
 			if (oscillation_index(&c->grid, sim_soil(s), h / ppc, &r.oscillation[next], &err))
 				r.ok = 0, printf("INFO oscillation index: %s\n", err.message);
@@ -90,6 +153,8 @@ static struct slope_run run_slope(const char *file, double h, int ppc, enum soil
 	if (!r.ok && s && sim_error(s)->code)
 		printf("INFO %s failed at t = %.4f s: %s\n", file, sim_time(s), sim_error(s)->message);
 	r.settlement = -sim_probe_value(s, 0);
+	r.relative_displacement = relative_displacement(s, offset);
+	free(offset);
 	measure_failure(sim_soil(s), h, &r);
 	r.soil_mass_error = fabs(sim_soil_mass(s) - soil0) / soil0;
 	r.water_mass_error = fabs(sim_water_mass(s) + sim_water_outflow_mass(s) - water0) / water0;
@@ -106,6 +171,23 @@ static void report(const char *label, double h, int ppc, const struct slope_run 
 	       r->ok ? "ran to the end" : "FAILED", r->steps, r->settlement, r->mobilised, r->lowest_mobilised,
 	       r->oscillation[0], r->oscillation[1], r->oscillation[2], r->soil_mass_error, r->water_mass_error,
 	       r->seconds);
+	if (r->band_sampled) {
+		printf("INFO mc slope %s h=%.2f m: pore pressure along the lower shear band at paper t = %.0f s (000 "
+		       "Fig. 5b), kPa at distance m:", label, h, BAND_PAPER_TIME);
+		for (int k = 0; k < BAND_SAMPLES; k += BAND_PRINT_EVERY)
+			printf(" %.1f:%.1f", r->band[k].distance, r->band[k].pore_pressure / 1e3);
+		printf("; largest water-soil relative displacement %.4f m (000 §5.3: 0.0014 m at k=1e-7, 0.0065 m "
+		       "at k=1e-3)\n", r->relative_displacement);
+	}
+}
+
+/* Every sample of the band has points within a cell: the band lies in the saturated slope. */
+static int band_in_water(const struct slope_run *r)
+{
+	int ok = r->band_sampled;
+	for (int k = 0; ok && k < BAND_SAMPLES; k++)
+		ok = r->band[k].points > 0 && isfinite(r->band[k].pore_pressure);
+	return ok;
 }
 
 static void check_slope(double h, int ppc, const char *size)
@@ -128,6 +210,14 @@ static void check_slope(double h, int ppc, const char *size)
 	      fmax(low.soil_mass_error, low.water_mass_error) < MASS_TOLERANCE, name,
 	      "soil %.1e/%.1e water %.1e/%.1e", high.soil_mass_error, low.soil_mass_error, high.water_mass_error,
 	      low.water_mass_error);
+	snprintf(name, sizeof name, "mc_slope_%s_lower_shear_band_sampled_in_the_water", size);
+	CHECK(band_in_water(&high) && band_in_water(&low), name, "k=1e-3 %s, k=1e-7 %s",
+	      band_in_water(&high) ? "every sample" : "a sample without water points",
+	      band_in_water(&low) ? "every sample" : "a sample without water points");
+	/* 000 §5.3: 0.0065 m at k = 1e-3 against 0.0014 m at k = 1e-7 m/s */
+	snprintf(name, sizeof name, "mc_slope_%s_water_moves_off_the_soil_more_at_high_permeability", size);
+	CHECK(high.relative_displacement > low.relative_displacement, name, "largest relative displacement "
+	      "k=1e-3 %.4f m vs k=1e-7 %.4f m", high.relative_displacement, low.relative_displacement);
 	snprintf(name, sizeof name, "mc_slope_%s_low_permeability_settles_more", size);
 	/* Not reproduced (docs/examples.md): at k = 1e-7 m/s the scarp behind the crest dilates at the
 	 * Mohr-Coulomb apex, the water cannot follow, and the suction (to -1.9 MPa at full size)
