@@ -14,6 +14,13 @@
  * piecewise-constant fields of patch averaging (Eq. 83) alike, apart from their true extrema
  * (O(h^2)). A checkerboard of amplitude A on a mean P scores about 2 A / P. The index measures
  * noise, not resolution.
+ *
+ * At the scale of cells. A field averaged cell-wise (App. A's h_patch = h) is constant inside each
+ * cell, so with 2x2 points per cell every point equals one of its two neighbours along each line
+ * and the point-level index is 0 however the cells jump. oscillation_index_blocks() applies the
+ * same overshoot rule to the means of p' over blocks of block x block lattice sites (block =
+ * particles_per_cell: the cells the points were seeded in), each block against its neighbouring
+ * blocks, normalised by the RMS of the block means. block = 1 is oscillation_index().
  */
 #ifndef PORO_OSCILLATION_H
 #define PORO_OSCILLATION_H
@@ -28,5 +35,9 @@
  * neighbours along a line, or when the mean effective stress is zero everywhere (*index is then 0). */
 enum poro_status oscillation_index(const struct case_grid *g, const struct particles *p, double spacing,
 				   double *index, struct poro_error *err);
+
+/* The same over blocks of block x block lattice sites (see above); PORO_EINVAL also for block < 1. */
+enum poro_status oscillation_index_blocks(const struct case_grid *g, const struct particles *p, double spacing,
+					  int block, double *index, struct poro_error *err);
 
 #endif
