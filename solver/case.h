@@ -23,6 +23,7 @@ enum case_shape { SHAPE_LINEAR, SHAPE_QUADRATIC_BSPLINE, SHAPE_CUBIC_BSPLINE };
 /* The matrix of the pressure solve: the Laplacian of 000 Eq. 61, or the projection G^T M^-1 G
  * consistent with the velocity correction (docs/numerics.md compares them). */
 enum pressure_projection { PROJECTION_LAPLACIAN, PROJECTION_CONSISTENT };
+enum pressure_stabilisation { PRESSURE_STABILISATION_NONE, PRESSURE_STABILISATION_SECOND_DIFFERENCE };
 /* Soil-phase stabilisation (000 §4.4.2, docs/numerics.md): none; F-bar with the node-wise averaged
  * volume change (Eqs. 79-80); modified F-bar (Eq. 81), which also scales Be^t to the patch-wise
  * averaged elastic Jacobian (Eqs. 82-83; patch 1.5 h for B-splines, the cell for linear); and the
@@ -68,6 +69,9 @@ struct case_formulation {
 	enum soil_stabilisation soil_stabilisation;   /* "none" (default), "fbar", "modified_fbar" or
 							 "modified_fbar_cellwise" */
 	int drag_in_correction;           /* drag also in the velocity correction (phase_coupling.h); default false */
+	enum pressure_stabilisation pressure_stabilisation; /* "none" (default) or "second_difference"
+							       (pressure_stabilisation.c; consistent projection only) */
+	double pressure_stabilisation_factor; /* > 0, weight of the second-difference penalty; default 10 */
 };
 
 struct case_grid {

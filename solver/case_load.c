@@ -33,6 +33,8 @@
 #define DEFAULT_FLUID_BULK_MODULUS 2.2e9  /* Pa, water */
 #define DEFAULT_GRAVITY_Y -9.81           /* m/s^2 */
 #define DEFAULT_PROGRESS_INTERVAL 1.0     /* s of wall time */
+#define DEFAULT_PRESSURE_STABILISATION_FACTOR 10.0 /* the strongest suppression measured without a
+						      measurable leak (docs/numerics.md) */
 
 /* Limits. */
 #define GRID_CELLS_MIN 3                  /* cells per direction: room for a quadratic B-spline */
@@ -55,6 +57,7 @@ static const char *const scheme_names[] = { "semi_implicit", NULL };
 static const char *const phases_names[] = { "double_point", "single_point", NULL };
 static const char *const shape_names[] = { "linear", "quadratic_bspline", "cubic_bspline", NULL };
 static const char *const projection_names[] = { "laplacian", "consistent", NULL };
+static const char *const pressure_stabilisation_names[] = { "none", "second_difference", NULL };
 static const char *const stabilisation_names[] = { "none", "fbar", "modified_fbar", "modified_fbar_cellwise",
 							   NULL };
 static const char *const permeability_law_names[] = { "constant", "kozeny_carman", "volume_ratio", NULL };
@@ -73,7 +76,8 @@ static const char *const top_keys[] = { "schema", "title", "formulation", "grid"
 					"probes", "checkpoint", NULL };
 static const char *const formulation_keys[] = { "scheme", "phases", "shape", "pore_pressure_smoothing",
 						"flip_fraction", "pressure_projection", "soil_stabilisation",
-						"drag_in_correction", NULL };
+						"drag_in_correction", "pressure_stabilisation",
+						"pressure_stabilisation_factor", NULL };
 static const char *const grid_keys[] = { "origin", "extent", "cell_size", NULL };
 /* A material's own keys; its model's keys are checked by case_read_material_model(). */
 static const char *const material_keys[] = { "name", "density", NULL };
@@ -246,6 +250,15 @@ static void read_formulation(struct case_reader *r, const json_t *root, struct c
 						f->pressure_projection);
 	f->soil_stabilisation = read_choice_or(r, o, p, "soil_stabilisation", CASE_OPTIONAL, stabilisation_names,
 					       f->soil_stabilisation);
+	f->pressure_stabilisation = read_choice_or(r, o, p, "pressure_stabilisation", CASE_OPTIONAL,
+						   pressure_stabilisation_names, f->pressure_stabilisation);
+	case_read_number(r, o, p, "pressure_stabilisation_factor", CASE_OPTIONAL, &POSITIVE,
+			 &f->pressure_stabilisation_factor);
+	/* the penalty is written into the consistent projection's energy (pressure_stabilisation.c) */
+	if (f->pressure_stabilisation != PRESSURE_STABILISATION_NONE && f->pressure_projection != PROJECTION_CONSISTENT)
+		case_problem(r, "/formulation/pressure_stabilisation",
+			     "\"%s\" needs /formulation/pressure_projection \"consistent\"",
+			     pressure_stabilisation_names[f->pressure_stabilisation]);
 }
 
 /* Checks that extent[d] is a whole number, at least GRID_CELLS_MIN, of cells. */
@@ -659,6 +672,8 @@ static void set_defaults(struct case_spec *c)
 	c->formulation.pore_pressure_smoothing = 1;
 	c->formulation.flip_fraction = 1;
 	c->formulation.drag_in_correction = 0;
+	c->formulation.pressure_stabilisation = PRESSURE_STABILISATION_NONE;
+	c->formulation.pressure_stabilisation_factor = DEFAULT_PRESSURE_STABILISATION_FACTOR;
 	c->fluid.density = DEFAULT_FLUID_DENSITY;
 	c->fluid.bulk_modulus = DEFAULT_FLUID_BULK_MODULUS;
 	c->gravity.acceleration[0] = 0;

@@ -15,6 +15,8 @@
  *    velocities then satisfy the weak continuity equation -G^T v = 0 exactly, and the pressure
  *    forces of the predictors use the same G on the nodal pressure, so a pressure error is removed
  *    in one step instead of being fed back (docs/numerics.md has the measurements).
+ *    Equal-order B-splines leave a node-to-node pressure pattern nearly outside A's reach; the
+ *    case may hold it down with formulation.pressure_stabilisation (pressure_stabilisation.c).
  *
  * Boundary conditions: impermeable faces need nothing (the natural condition of Eq. 32). Nodes
  * on the free water surface and on drained faces get p^{t+1} = 0, i.e. dp_I = -p^t_I. A node is
@@ -64,8 +66,10 @@ enum poro_status pressure_system_init(struct pressure_system *ps, const struct g
 	ps->values = malloc(nnz_max * sizeof(double));
 	ps->b = malloc(nodes * sizeof(double));
 	ps->x = malloc(nodes * sizeof(double));
+	ps->diagonal = malloc(nodes * sizeof(double));
+	ps->interior = malloc(nodes);
 	if (!ps->stencil || !ps->grad_s || !ps->grad_w || !ps->unknown || !ps->colptr || !ps->rowidx ||
-	    !ps->values || !ps->b || !ps->x) {
+	    !ps->values || !ps->b || !ps->x || !ps->diagonal || !ps->interior) {
 		pressure_system_release(ps);
 		return poro_error_set(err, PORO_ENOMEM, "cannot allocate the pressure system");
 	}
@@ -83,6 +87,8 @@ void pressure_system_release(struct pressure_system *ps)
 	free(ps->values);
 	free(ps->b);
 	free(ps->x);
+	free(ps->diagonal);
+	free(ps->interior);
 	spd_solver_destroy(&ps->solver);
 	memset(ps, 0, sizeof *ps);
 }
@@ -385,6 +391,7 @@ enum poro_status pressure_solve(struct sim *s)
 	if (ps->exact) {
 		memset(s->f.rhs, 0, sizeof(double) * (size_t)s->grid.node_count);
 		assemble_exact_projection(s);
+		pressure_stabilise(s);   /* pressure_stabilisation.c */
 	} else {
 		for (idx_t q = 0; q < p->n; q++) {
 			const double rho_s = s->materials[s->spec->bodies[p->body[q]].material].density;

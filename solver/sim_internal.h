@@ -28,6 +28,8 @@ struct pressure_system {
 	idx_t *unknown;           /* [node_count] unknown number of a node, -1 if not an unknown */
 	idx_t *colptr, *rowidx;   /* CSC upper triangle of the reduced system */
 	double *values, *b, *x;
+	double *diagonal;         /* [node_count] A's diagonal before the pressure stabilisation */
+	signed char *interior;    /* [node_count] 1: the stabilisation may act on the node */
 	struct spd_solver *solver;
 };
 
@@ -83,6 +85,9 @@ enum poro_status pressure_system_init(struct pressure_system *ps, const struct g
 void pressure_system_release(struct pressure_system *ps);
 void pressure_mark_dirichlet(struct sim *s);
 enum poro_status pressure_solve(struct sim *s);
+/* Adds the case's pressure stabilisation to the assembled consistent projection (stencil and
+ * right-hand side); nothing when the case has none. pressure_stabilisation.c. */
+void pressure_stabilise(struct sim *s);
 void pressure_gradient_operators(struct sim *s);
 void pressure_apply_gradient(const struct sim *s, const double *G, const double *pressure, double *out);
 

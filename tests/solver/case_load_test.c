@@ -179,6 +179,9 @@ static void test_minimal_defaults(const struct case_spec *c)
 	      f->shape == SHAPE_QUADRATIC_BSPLINE && f->pore_pressure_smoothing == 1 && f->flip_fraction == 1,
 	      "default formulation", "phases %d shape %d smoothing %d flip %g", f->phases, f->shape,
 	      f->pore_pressure_smoothing, f->flip_fraction);
+	CHECK(f->pressure_stabilisation == PRESSURE_STABILISATION_NONE && f->pressure_stabilisation_factor == 10,
+	      "default pressure stabilisation", "kind %d factor %g", f->pressure_stabilisation,
+	      f->pressure_stabilisation_factor);
 	CHECK(c->bodies[0].permeability_law == PERMEABILITY_CONSTANT, "default permeability law", "got %d",
 	      c->bodies[0].permeability_law);
 	CHECK(c->fluid.density == 1000 && c->fluid.bulk_modulus == 2.2e9, "default fluid",
@@ -336,6 +339,27 @@ static void test_out_of_range(void)
 		       "/materials/0/poisson_ratio: must be > -1 and < 0.5, got 0.7");
 	expect_invalid("flip fraction above one", "/formulation/flip_fraction", "1.05",
 		       "/formulation/flip_fraction: must be >= 0 and <= 1, got 1.05");
+	expect_invalid("pressure stabilisation without the consistent projection", "/formulation/pressure_stabilisation",
+		       "\"second_difference\"",
+		       "/formulation/pressure_stabilisation: \"second_difference\" needs /formulation/pressure_projection "
+		       "\"consistent\"");
+	expect_invalid("unknown pressure stabilisation", "/formulation/pressure_stabilisation", "\"smooth\"",
+		       "/formulation/pressure_stabilisation: must be one of 'none', 'second_difference', got 'smooth'");
+	expect_invalid("pressure stabilisation factor zero", "/formulation/pressure_stabilisation_factor", "0",
+		       "/formulation/pressure_stabilisation_factor: must be > 0, got 0");
+	{
+		const struct edit e[] = { { "/formulation/pressure_projection", "\"consistent\"" },
+					  { "/formulation/pressure_stabilisation", "\"second_difference\"" },
+					  { "/formulation/pressure_stabilisation_factor", "2.385" } };
+		char *text = edited(full_case, e, 3);
+		struct case_spec *c = load_valid("pressure stabilisation with the consistent projection", text);
+		CHECK(c && c->formulation.pressure_stabilisation == PRESSURE_STABILISATION_SECOND_DIFFERENCE &&
+		      c->formulation.pressure_stabilisation_factor == 2.385, "pressure stabilisation read",
+		      "kind %d factor %g", c ? (int)c->formulation.pressure_stabilisation : -1,
+		      c ? c->formulation.pressure_stabilisation_factor : 0.0);
+		case_destroy(&c);
+		free(text);
+	}
 	expect_invalid("particles per cell 9", "/bodies/0/particles_per_cell", "9",
 		       "/bodies/0/particles_per_cell: must be >= 1 and <= 8, got 9");
 	expect_invalid("extent not a multiple", "/grid/extent/0", "1.15",

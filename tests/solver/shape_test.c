@@ -1,5 +1,5 @@
 /*
- * shape_test.c - shape functions (issue item g): partition of unity and zero gradient sum at
+ * shape_test.c - shape functions: partition of unity and zero gradient sum at
  * high-entropy points, including the half cells next to the grid edges; gradients against
  * central finite differences of the weights; non-negativity; the interpolating edge property;
  * reproduction of linear fields (sum S_i x_i = x, sum dS_i x_i = 1) for linear, quadratic and

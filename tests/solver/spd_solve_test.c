@@ -1,5 +1,5 @@
 /*
- * spd_solve_test.c - the CHOLMOD gateway (issue item g): solves of SPD systems checked by the
+ * spd_solve_test.c - the CHOLMOD gateway: solves of SPD systems checked by the
  * scaled residual ||A x - b|| / (||A|| ||x|| + ||b||) for direct solves and the relative residual
  * for solves answered by conjugate gradients on the previous factor; the factor reused while the
  * values change little, a refactorisation when they change a lot, a fresh analysis when the

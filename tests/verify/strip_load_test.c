@@ -1,6 +1,6 @@
 /*
  * strip_load_test.c - the strip load on a saturated layer of 002 §4.2 (Table 2), run with the
- * semi-implicit double-point scheme (issue item f).
+ * semi-implicit double-point scheme.
  *
  * 002 states a 10 m x 10 m half domain, 0.05 m cells, 2x2 points per cell, 1,600 points and a
  * 0.3 m strip; only a 1 m x 1 m domain has 1,600 points at that cell size, so the case uses it.

@@ -1,5 +1,5 @@
 /*
- * xie_leo_test.c - 000 §5.2 against Xie and Leo's large-strain closed form (issue item d).
+ * xie_leo_test.c - 000 §5.2 against Xie and Leo's large-strain closed form.
  *
  * Table 2 column (E = 1 MPa, q = 200 kPa, h = 0.05 m, dt = 5e-4 s, to Tv = 2):
  *  - small-strain elastic: top settlement within 3% of Eq. 87 at U = 0.25, 0.5, 0.75 and at the
@@ -10,6 +10,9 @@
  *    E ln(l) / l = -q), and the difference to the small-strain run reported next to the
  *    paper's "about 17%";
  *  - soil and water mass conserved to 1e-12 at every step.
+ * The double-point cases (xie_leo.json, xie_leo_hencky.json) run with the second-difference
+ * pressure stabilisation (docs/numerics.md): without it the node-to-node pressure pattern
+ * stalled the column from U = 0.5 on (20% short at the end, Hencky 39% short).
  * The top surface is the top row of points plus half their current spacing (F_yy h / ppc / 2).
  */
 #include <stdlib.h>
@@ -190,7 +193,7 @@ static void check_variant(const struct expectation *e, struct run *out)
 int main(void)
 {
 	const struct expectation variants[2] = {
-		{"double_point", CASES "xie_leo.json", 1, 0, {1, 1, 1, 1}, {1, 1, 1}},
+		{"double_point", CASES "xie_leo.json", 1, 0, {1, 1, 1, 0}, {0, 1, 1}},
 		{"single_point", CASES "xie_leo_single_point.json", 0, 0, {1, 1, 1, 0}, {0, 0, 0}},
 	};
 	struct run small[2];
@@ -215,7 +218,7 @@ int main(void)
 	printf("INFO xie-leo hencky (double point) at Tv = 2: settlement %.5f m, Hencky closed form %.5f m (%.2f%%); "
 	       "small strain settles %.1f%% more (paper 000 §5.2: about 17%%)\n", hencky.settle[3], hencky_final,
 	       100 * rel, 100 * (small[0].settle[3] / hencky.settle[3] - 1));
-	CHECK_KNOWN_FAILURE(hencky.ok && rel <= 0.03, "xie_leo_hencky_final_settlement_within_3pct", "%.2f%%", 100 * rel);
+	CHECK(hencky.ok && rel <= 0.03, "xie_leo_hencky_final_settlement_within_3pct", "%.2f%%", 100 * rel);
 	CHECK(hencky.drift <= 1e-12, "xie_leo_hencky_mass_conserved", "drift %.3e", hencky.drift);
 	HARNESS_EXIT();
 }
