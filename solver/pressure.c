@@ -93,6 +93,17 @@ void pressure_system_release(struct pressure_system *ps)
 	memset(ps, 0, sizeof *ps);
 }
 
+/* fill[c] = the summed volumes of the points of p in cell c (points outside the grid left out). */
+static void cell_volumes(const struct grid *g, const struct particles *p, double *fill)
+{
+	memset(fill, 0, sizeof(double) * (size_t)g->cell_count);
+	for (idx_t q = 0; q < p->n; q++) {
+		idx_t c = grid_cell_of(g, p->x + 2 * q);
+		if (c >= 0)
+			fill[c] += p->volume[q];
+	}
+}
+
 /* Free surface and drained faces: marks f->dirichlet (see the file comment). */
 void pressure_mark_dirichlet(struct sim *s)
 {
@@ -106,24 +117,12 @@ void pressure_mark_dirichlet(struct sim *s)
 	const int open[FACE_COUNT] = {bc[FACE_LEFT].water == CONSTRAINT_FREE, bc[FACE_RIGHT].water == CONSTRAINT_FREE,
 				      bc[FACE_BOTTOM].water == CONSTRAINT_FREE, bc[FACE_TOP].water == CONSTRAINT_FREE};
 	double *fill = s->cell_fill;
-	memset(f->cell_wet, 0, (size_t)g->cell_count);
-	memset(fill, 0, sizeof(double) * (size_t)g->cell_count);
-	for (idx_t q = 0; q < w->n; q++) {
-		idx_t c = grid_cell_of(g, w->x + 2 * q);
-		if (c >= 0)
-			fill[c] += w->volume[q];
-	}
+	cell_volumes(g, w, fill);
 	for (idx_t c = 0; c < g->cell_count; c++)
 		f->cell_wet[c] = fill[c] >= full;
 	if (s->double_point) {
 		/* saturated soil fills a cell below the top of its column's water (file comment) */
-		const struct particles *soil = &s->soil;
-		memset(fill, 0, sizeof(double) * (size_t)g->cell_count);
-		for (idx_t q = 0; q < soil->n; q++) {
-			idx_t c = grid_cell_of(g, soil->x + 2 * q);
-			if (c >= 0)
-				fill[c] += soil->volume[q];
-		}
+		cell_volumes(g, &s->soil, fill);
 		for (idx_t ci = 0; ci < g->cells[0]; ci++) {
 			int below_water = 0;
 			for (idx_t cj = g->cells[1] - 1; cj >= 0; cj--) {

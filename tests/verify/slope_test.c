@@ -76,20 +76,22 @@ static void measure_failure(const struct particles *p, double h, struct slope_ru
 	}
 }
 
-/* The band's pore pressure from the points that carry it (water in double point), compression
- * positive as in result.h5, averaged within one cell of each sample (REPORT_LINE_RADIUS). */
+/* The band's pore pressure from the points that carry it (sim_pore_pressure: water in double
+ * point, compression positive as in result.h5), averaged within one cell of each sample
+ * (REPORT_LINE_RADIUS). */
 static int sample_band(const struct sim *s, double h, struct slope_run *r)
 {
-	const struct particles *w = sim_water(s);
+	const idx_t n = sim_pressure_point_count(s);
 	struct report_line band;
 	struct poro_error err = {0};
-	double *p = malloc(sizeof *p * ((size_t)w->n + 1));
-	int ok = p && !report_line_parse(BAND, &band, &err) && band.samples == BAND_SAMPLES;
-	for (idx_t q = 0; ok && q < w->n; q++)
-		p[q] = -w->pressure[q];
-	if (ok)
-		report_line_sample_points(&band, w->x, p, w->n, REPORT_LINE_RADIUS * h, r->band);
+	double *p = malloc(sizeof *p * ((size_t)n + 1)), *x = malloc(sizeof *x * 2 * ((size_t)n + 1));
+	int ok = p && x && !report_line_parse(BAND, &band, &err) && band.samples == BAND_SAMPLES;
+	if (ok) {
+		sim_pore_pressure(s, p, x);
+		report_line_sample_points(&band, x, p, n, REPORT_LINE_RADIUS * h, r->band);
+	}
 	free(p);
+	free(x);
 	return ok;
 }
 
