@@ -41,9 +41,15 @@ enum material_model { MODEL_LINEAR_ELASTIC, MODEL_HENCKY, MODEL_MOHR_COULOMB, MO
  * 69-76; the default) or small strain (the symmetric part of dF - I). */
 enum material_strain { STRAIN_FINITE, STRAIN_SMALL };
 
-/* constant; Kozeny-Carman k = C1 n^3 / (1 - n)^2 (000 step 8g); volume_ratio k = k0 V / V0, Xie and
- * Leo's assumption that k falls with (1 + e) as m_v does, under which 000 Eq. 87 holds. */
-enum permeability_law { PERMEABILITY_CONSTANT, PERMEABILITY_KOZENY_CARMAN, PERMEABILITY_VOLUME_RATIO };
+/* constant; Kozeny-Carman k = C1 n^3 / (1 - n)^2 (000 step 8g); volume_ratio k = k0 V / V0;
+ * volume_ratio_squared k = k0 (V / V0)^2 = k0 ((1 + e)/(1 + e0))^2, the law under which Xie and Leo's
+ * large-strain solution (000 Eqs. 87-90) is exact (docs/numerics.md, "Xie-Leo permeability"). */
+enum permeability_law {
+	PERMEABILITY_CONSTANT,
+	PERMEABILITY_KOZENY_CARMAN,
+	PERMEABILITY_VOLUME_RATIO,
+	PERMEABILITY_VOLUME_RATIO_SQUARED
+};
 
 /* Velocity constraint of one phase on a grid face: free, slip (normal component zero: a roller),
  * fixed (both components zero). */
@@ -130,8 +136,9 @@ struct case_body {
 	int particles_per_cell;           /* points per cell per direction (2 means 2x2) */
 	double porosity;                  /* initial porosity n0, 0 < n0 < 1 */
 	double hydraulic_conductivity;    /* k0, m/s, > 0 */
-	enum permeability_law permeability_law; /* "constant" (default), "kozeny_carman" (000 step 8g) or
-						   "volume_ratio" (k = k0 V/V0, Xie and Leo 2004) */
+	enum permeability_law permeability_law; /* "constant" (default), "kozeny_carman" (000 step 8g),
+						   "volume_ratio" (k = k0 V/V0) or "volume_ratio_squared"
+						   (k = k0 (V/V0)^2, Xie and Leo 2004) */
 };
 
 struct case_time_function {

@@ -60,7 +60,8 @@ static const char *const projection_names[] = { "laplacian", "consistent", NULL 
 static const char *const pressure_stabilisation_names[] = { "none", "second_difference", NULL };
 static const char *const stabilisation_names[] = { "none", "fbar", "modified_fbar", "modified_fbar_cellwise",
 							   NULL };
-static const char *const permeability_law_names[] = { "constant", "kozeny_carman", "volume_ratio", NULL };
+static const char *const permeability_law_names[] = { "constant", "kozeny_carman", "volume_ratio",
+							       "volume_ratio_squared", NULL };
 static const char *const constraint_names[] = { "free", "slip", "fixed", NULL };
 static const char *const drainage_names[] = { "impermeable", "drained", NULL };
 static const char *const face_names[] = { "left", "right", "bottom", "top", NULL };

@@ -32,6 +32,7 @@
 #include <math.h>
 #include <string.h>
 
+#include "permeability.h"
 #include "phase_coupling.h"
 #include "shape.h"
 #include "sim_internal.h"
@@ -501,13 +502,8 @@ static enum poro_status update_soil_kinematics(struct sim *s)
 		}
 		p->porosity[q] = n;
 		const struct case_body *body = &s->spec->bodies[p->body[q]];
-		if (body->permeability_law == PERMEABILITY_KOZENY_CARMAN) {
-			double n0 = p->porosity0[q];
-			double C1 = body->hydraulic_conductivity * (1.0 - n0) * (1.0 - n0) / (n0 * n0 * n0);
-			p->conductivity[q] = C1 * n * n * n / ((1.0 - n) * (1.0 - n));
-		} else if (body->permeability_law == PERMEABILITY_VOLUME_RATIO) {
-			p->conductivity[q] = body->hydraulic_conductivity * J;   /* (1 + e)/(1 + e0) = J */
-		}
+		p->conductivity[q] = permeability_conductivity(body->permeability_law, body->hydraulic_conductivity,
+							       p->porosity0[q], n, J);   /* (8g) */
 	}
 	if (bad >= 0)
 		return poro_error_set(&s->err, PORO_ESOLVER, "soil point %ld at (%.6g, %.6g) m: volume ratio %.6g "

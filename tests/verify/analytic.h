@@ -10,7 +10,8 @@
  * same series as Terzaghi. 000 writes the series with 4 M^2 Tv and sin(2 M z / H), which is the
  * same solution with H the thickness of a layer drained on both faces; for the singly drained
  * column used here the drainage length is the column height and the series is the one below
- * (002 Eq. 36 writes it this way).
+ * (002 Eq. 36 writes it this way). The solution is exact for (1 + e) = (1 + e0) exp(-m_v sigma')
+ * and a conductivity k = k0 ((1 + e)/(1 + e0))^2 (tests/solver/permeability_test.c).
  */
 #ifndef PORO_ANALYTIC_H
 #define PORO_ANALYTIC_H
@@ -50,6 +51,20 @@ static inline double consolidation_degree(double Tv)
 		sum += 2.0 / (M * M) * exp(-M * M * Tv);
 	}
 	return 1.0 - sum;
+}
+
+/* Tv at which the degree of consolidation is U, 0 < U < 1 (bisection on the monotone U(Tv)). */
+static inline double time_factor_for_degree(double U)
+{
+	double lo = 1e-6, hi = 10;
+	for (int i = 0; i < 200; i++) {
+		double mid = 0.5 * (lo + hi);
+		if (consolidation_degree(mid) < U)
+			lo = mid;
+		else
+			hi = mid;
+	}
+	return 0.5 * (lo + hi);
 }
 
 /* Xie-Leo settlement (000 Eq. 87 in the single-drainage normalisation), m. */

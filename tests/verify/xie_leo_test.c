@@ -13,6 +13,9 @@
  * The double-point cases (xie_leo.json, xie_leo_hencky.json) run with the second-difference
  * pressure stabilisation (docs/numerics.md): without it the node-to-node pressure pattern
  * stalled the column from U = 0.5 on (20% short at the end, Hencky 39% short).
+ * All three cases use k = k0 (V/V0)^2 (permeability_law "volume_ratio_squared"), the law under
+ * which Eqs. 87-90 are exact (tests/solver/permeability_test.c solves Gibson's equation to show it);
+ * with k = k0 V/V0 the column ran 9-12% ahead of Eq. 87 at U = 0.25-0.75.
  * The top surface is the top row of points plus half their current spacing (F_yy h / ppc / 2).
  */
 #include <stdlib.h>
@@ -43,20 +46,6 @@ static struct column column_of(const struct case_spec *c)
 	};
 	col.mv = 1.0 / col.E;     /* nu = 0 (Table 2) */
 	return col;
-}
-
-/* Tv at which the degree of consolidation is U (bisection on the monotone U(Tv)). */
-static double time_factor_for_degree(double U)
-{
-	double lo = 1e-6, hi = 10;
-	for (int i = 0; i < 200; i++) {
-		double mid = 0.5 * (lo + hi);
-		if (consolidation_degree(mid) < U)
-			lo = mid;
-		else
-			hi = mid;
-	}
-	return 0.5 * (lo + hi);
 }
 
 /* Settlement of the top surface: mean over the top row of its current top edge. */
@@ -193,8 +182,8 @@ static void check_variant(const struct expectation *e, struct run *out)
 int main(void)
 {
 	const struct expectation variants[2] = {
-		{"double_point", CASES "xie_leo.json", 1, 0, {1, 1, 1, 0}, {0, 1, 1}},
-		{"single_point", CASES "xie_leo_single_point.json", 0, 0, {1, 1, 1, 0}, {0, 0, 0}},
+		{"double_point", CASES "xie_leo.json", 1, 0, {0, 1, 0, 0}, {0, 0, 0}},
+		{"single_point", CASES "xie_leo_single_point.json", 0, 0, {1, 1, 0, 0}, {1, 0, 0}},
 	};
 	struct run small[2];
 	for (int v = 0; v < 2; v++)
