@@ -15,7 +15,10 @@
  * stalled the column from U = 0.5 on (20% short at the end, Hencky 39% short).
  * All three cases use k = k0 (V/V0)^2 (permeability_law "volume_ratio_squared"), the law under
  * which Eqs. 87-90 are exact (tests/solver/permeability_test.c solves Gibson's equation to show it);
- * with k = k0 V/V0 the column ran 9-12% ahead of Eq. 87 at U = 0.25-0.75.
+ * with k = k0 V/V0 the column ran 9-12% ahead of Eq. 87 at U = 0.25-0.75. They also take the drag
+ * into the velocity correction (formulation.drag_in_correction): the paper's Eq. 65 gives every
+ * pressure increment an apparent conductivity of about 9e-4 m/s at this dt, nearly the column's
+ * own 1e-3 m/s, which made the single-point column run 6% ahead at U = 0.25.
  * The top surface is the top row of points plus half their current spacing (F_yy h / ppc / 2).
  */
 #include <stdlib.h>
@@ -182,8 +185,8 @@ static void check_variant(const struct expectation *e, struct run *out)
 int main(void)
 {
 	const struct expectation variants[2] = {
-		{"double_point", CASES "xie_leo.json", 1, 0, {0, 1, 0, 0}, {0, 0, 0}},
-		{"single_point", CASES "xie_leo_single_point.json", 0, 0, {1, 1, 0, 0}, {1, 0, 0}},
+		{"double_point", CASES "xie_leo.json", 1, 0, {1, 0, 0, 0}, {0, 0, 0}},
+		{"single_point", CASES "xie_leo_single_point.json", 0, 0, {0, 0, 0, 0}, {0, 0, 0}},
 	};
 	struct run small[2];
 	for (int v = 0; v < 2; v++)
