@@ -3,8 +3,12 @@
  * semi-implicit double-point scheme.
  *
  * 002 states a 10 m x 10 m half domain, 0.05 m cells, 2x2 points per cell, 1,600 points and a
- * 0.3 m strip; only a 1 m x 1 m domain has 1,600 points at that cell size, so the case uses it.
- * Reported: the maximum displacement at t = 0.1 s next to 002's 6.737 mm. Asserted: the pore
+ * 0.3 m strip. These do not fit together: 10 m x 10 m at 2x2 per cell has 1,600 points per set
+ * only with 0.5 m cells, and a 0.3 m strip would then be under one cell. The case reads the cell
+ * and the strip as a factor-10 slip (0.5 m cells, 3 m half-strip); the earlier reading, a
+ * 1 m x 1 m domain with 0.05 m cells and the 0.3 m strip, displaced 0.561 mm, twelve times less
+ * than 002 reports. Asserted: the maximum displacement at t = 0.1 s within
+ * DISPLACEMENT_TOLERANCE of 002's 6.737 mm (measured 6.618 mm, 1.8% below), and the pore
  * pressure has no checkerboard. The measure is the RMS over interior points of p_i minus the
  * mean of its four lattice neighbours (reference positions), divided by max |p|: a checkerboard
  * scores O(1), a smooth field O(h^2). With the node-wise smoothing (000 Eq. 77) it must stay
@@ -16,7 +20,8 @@
 #include "poro.h"
 
 #define CASE_FILE "tests/cases/strip_load_002.json"
-#define PAPER_MAX_DISPLACEMENT 6.737e-3
+#define PAPER_MAX_DISPLACEMENT 6.737e-3   /* m, 002 §4.2 at t = 0.1 s */
+#define DISPLACEMENT_TOLERANCE 0.03        /* relative */
 
 struct outcome {
 	double umax, roughness, drift;
@@ -86,6 +91,9 @@ int main(void)
 	       "roughness %.4f with smoothing, %.4f without\n", 1e3 * smooth.umax, 1e3 * PAPER_MAX_DISPLACEMENT,
 	       smooth.roughness, rough.roughness);
 	CHECK(smooth.ok && rough.ok, "strip_load_runs", "a run failed");
+	const double rel = fabs(smooth.umax - PAPER_MAX_DISPLACEMENT) / PAPER_MAX_DISPLACEMENT;
+	CHECK(smooth.ok && rel <= DISPLACEMENT_TOLERANCE, "strip_load_max_displacement_matches_002",
+	      "%.3f mm against 002's %.3f mm (%.1f%%)", 1e3 * smooth.umax, 1e3 * PAPER_MAX_DISPLACEMENT, 100 * rel);
 	CHECK(smooth.ok && smooth.roughness < 0.01, "strip_load_pore_pressure_has_no_checkerboard",
 	      "roughness %.4f", smooth.roughness);
 	CHECK(rough.roughness > 5 * smooth.roughness, "strip_load_smoothing_removes_checkerboard",
