@@ -25,6 +25,8 @@ struct pressure_system {
 	int g_radius, g_width;    /* reach of the gradient operators G: S - 1, and 2 g_radius + 1 */
 	double *stencil;          /* [node_count * width^2] matrix entries by offset of J from I */
 	double *grad_s, *grad_w;  /* [node_count * g_width^2 * 2] G_s, G_w (Eqs. 67-68) by offset */
+	double *coupling;         /* [node_count * 2 * 3] K^-1 (ss, sw, ww) of each node and component,
+				     the correction's phase coupling (consistent projection only) */
 	idx_t *unknown;           /* [node_count] unknown number of a node, -1 if not an unknown */
 	idx_t *colptr, *rowidx;   /* CSC upper triangle of the reduced system */
 	double *values, *b, *x;
