@@ -168,15 +168,19 @@ static void assemble_laplacian(struct sim *s, const struct particles *p, const d
 	for (idx_t q = 0; q < p->n; q++) {
 		const double *dw = p->dw + (size_t)q * 2 * nn;
 		const double c = coef[q];
-		for (int k = 0; k < nn; k++) {
-			const idx_t I = p->node0[q] + k % S + (k / S) * g->nodes[0];
-			double *row = ps->stencil + (size_t)I * W * W;
-			const double gx = c * dw[2 * k], gy = c * dw[2 * k + 1];
-			for (int l = 0; l < nn; l++) {
-				int dx = l % S - k % S, dy = l / S - k / S;
-				row[(dx + R) + (dy + R) * W] += gx * dw[2 * l] + gy * dw[2 * l + 1];
+		for (int ky = 0; ky < S; ky++)
+			for (int kx = 0; kx < S; kx++) {
+				const int k = kx + ky * S;
+				const idx_t I = p->node0[q] + kx + ky * g->nodes[0];
+				double *row = ps->stencil + (size_t)I * W * W;
+				const double gx = c * dw[2 * k], gy = c * dw[2 * k + 1];
+				for (int ly = 0; ly < S; ly++) {   /* one grid line of J: adjacent entries */
+					double *dst = row + (R - kx) + (ly - ky + R) * W;
+					const double *src = dw + 2 * ly * S;
+					for (int lx = 0; lx < S; lx++)
+						dst[lx] += gx * src[2 * lx] + gy * src[2 * lx + 1];
+				}
 			}
-		}
 	}
 }
 
@@ -189,16 +193,20 @@ static void add_gradient_operator(const struct sim *s, const struct particles *p
 	for (idx_t q = 0; q < p->n; q++) {
 		const double *w = p->w + (size_t)q * nn, *dw = p->dw + (size_t)q * 2 * nn;
 		const double V = p->volume[q];
-		for (int k = 0; k < nn; k++) {
-			const idx_t I = p->node0[q] + k % S + (k / S) * g->nodes[0];
-			double *row = G + (size_t)I * W * W * 2;
-			const double vs = V * w[k];
-			for (int l = 0; l < nn; l++) {
-				int off = (l % S - k % S + R) + (l / S - k / S + R) * W;
-				row[2 * off] += vs * dw[2 * l];
-				row[2 * off + 1] += vs * dw[2 * l + 1];
+		for (int ky = 0; ky < S; ky++)
+			for (int kx = 0; kx < S; kx++) {
+				const idx_t I = p->node0[q] + kx + ky * g->nodes[0];
+				double *row = G + (size_t)I * W * W * 2;
+				const double vs = V * w[kx + ky * S];
+				/* the support nodes J of one grid line are adjacent in the row and in dw:
+				 * 2 S contiguous products per line */
+				for (int ly = 0; ly < S; ly++) {
+					double *dst = row + 2 * ((R - kx) + (ly - ky + R) * W);
+					const double *src = dw + 2 * ly * S;
+					for (int t = 0; t < 2 * S; t++)
+						dst[t] += vs * src[t];
+				}
 			}
-		}
 	}
 }
 
