@@ -286,8 +286,7 @@ static void assemble_exact_projection(struct sim *s)
 	struct pressure_system *ps = &s->ps;
 	const int Wg = ps->g_width, Rg = ps->g_radius, W = ps->width, R = ps->radius;
 	const idx_t nx = g->nodes[0], ny = g->nodes[1];
-	/* offsets of the G stencil, tabulated: integer division by the run-time width in the
-	 * innermost loop cost more than the multiply-adds */
+	/* node offsets (x, y) of the G stencil entries, tabulated once */
 	enum { G_OFFSETS_MAX = (2 * SHAPE_SUPPORT_MAX - 1) * (2 * SHAPE_SUPPORT_MAX - 1) };
 	int ox[G_OFFSETS_MAX], oy[G_OFFSETS_MAX];
 	assert(Wg * Wg <= G_OFFSETS_MAX);
