@@ -7,6 +7,9 @@ packages=(
   build-essential pkg-config
   libjansson-dev        # JSON everywhere (case files, API)
   libsuitesparse-dev    # CHOLMOD (pressure Poisson), UMFPACK (u-p-U)
+  libopenblas0-openmp   # the BLAS CHOLMOD's supernodal factor and solves run on: Debian's default
+                        # is the reference BLAS, which made the pressure solve twice as slow
+                        # (docs/performance.md); the OpenMP build shares our OpenMP runtime
   libhdf5-dev hdf5-tools  # results; h5dump for inspecting
   libmicrohttpd-dev     # server HTTP
   libsqlite3-dev        # server store
