@@ -255,16 +255,7 @@ static double correction_drag(const struct sim *s, idx_t I)
 	return s->spec->formulation.drag_in_correction ? s->f.drag_dt[I] : 0.0;
 }
 
-/* A = sum over nodes and velocity components of [G_s; G_w]^T K^-1 [G_s; G_w], K^-1 the phase
- * coupling of the correction (phase_coupling.h; without drag, G_s^T M_s^-1 G_s + G_w^T M_w^-1 G_w),
- * and b = -sum (G_s^T v_s* + G_w^T v_w*) / dt over the free components: the projection that
- * makes the corrected velocities satisfy -G^T v = 0 exactly. A is SPD because K^-1 is.
- *
- * Assembled row by row: row P gathers from the velocity nodes I whose G rows reach P, so each
- * thread writes only its own rows and a row stays in cache while it fills (scattering from I
- * into nine rows was bound by memory latency: 0.58 us per material-point step on the benchmark
- * block). I runs in ascending order and the components inside it, the order the scatter had, so
- * every entry sums the same terms in the same order. */
+/* K^-1 (ss, sw, ww) of the correction at every node and component, into ps->coupling. */
 static void store_correction_coupling(struct sim *s)
 {
 	const struct grid_fields *f = &s->f;
@@ -279,6 +270,16 @@ static void store_correction_coupling(struct sim *s)
 		}
 }
 
+/* A = sum over nodes and velocity components of [G_s; G_w]^T K^-1 [G_s; G_w], K^-1 the phase
+ * coupling of the correction (phase_coupling.h; without drag, G_s^T M_s^-1 G_s + G_w^T M_w^-1 G_w),
+ * and b = -sum (G_s^T v_s* + G_w^T v_w*) / dt over the free components: the projection that
+ * makes the corrected velocities satisfy -G^T v = 0 exactly. A is SPD because K^-1 is.
+ *
+ * Assembled row by row: row P gathers from the velocity nodes I whose G rows reach P, so each
+ * thread writes only its own rows and a row stays in cache while it fills (scattering from I
+ * into nine rows was bound by memory latency: 0.58 us per material-point step on the benchmark
+ * block). I runs in ascending order and the components inside it, the order the scatter had, so
+ * every entry sums the same terms in the same order. */
 static void assemble_exact_projection(struct sim *s)
 {
 	const struct grid *g = &s->grid;
