@@ -24,6 +24,7 @@ enum case_shape { SHAPE_LINEAR, SHAPE_QUADRATIC_BSPLINE, SHAPE_CUBIC_BSPLINE };
  * consistent with the velocity correction (docs/numerics.md compares them). */
 enum pressure_projection { PROJECTION_LAPLACIAN, PROJECTION_CONSISTENT };
 enum pressure_stabilisation { PRESSURE_STABILISATION_NONE, PRESSURE_STABILISATION_SECOND_DIFFERENCE };
+enum free_surface_condition { FREE_SURFACE_NODES, FREE_SURFACE_INTERPOLATED };
 /* Soil-phase stabilisation (000 §4.4.2, docs/numerics.md): none; F-bar with the node-wise averaged
  * volume change (Eqs. 79-80); modified F-bar (Eq. 81), which also scales Be^t to the patch-wise
  * averaged elastic Jacobian (Eqs. 82-83; patch 1.5 h for B-splines, the cell for linear); and the
@@ -78,6 +79,9 @@ struct case_formulation {
 	enum pressure_stabilisation pressure_stabilisation; /* "none" (default) or "second_difference"
 							       (pressure_stabilisation.c; consistent projection only) */
 	double pressure_stabilisation_factor; /* > 0, weight of the second-difference penalty; default 10 */
+	enum free_surface_condition free_surface; /* "nodes" (default) or "interpolated" (free_surface.c;
+						     consistent projection only) */
+	double free_surface_penalty_factor;   /* > 0, weight of the interpolated condition; default 1e4 */
 };
 
 struct case_grid {

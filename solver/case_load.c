@@ -35,6 +35,8 @@
 #define DEFAULT_PROGRESS_INTERVAL 1.0     /* s of wall time */
 #define DEFAULT_PRESSURE_STABILISATION_FACTOR 10.0 /* the strongest suppression measured without a
 						      measurable leak (docs/numerics.md) */
+#define DEFAULT_FREE_SURFACE_PENALTY_FACTOR 1e4 /* surface pressure held to about 1e-4 of the interior's,
+						   the matrix still well conditioned for CHOLMOD */
 
 /* Limits. */
 #define GRID_CELLS_MIN 3                  /* cells per direction: room for a quadratic B-spline */
@@ -58,6 +60,7 @@ static const char *const phases_names[] = { "double_point", "single_point", NULL
 static const char *const shape_names[] = { "linear", "quadratic_bspline", "cubic_bspline", NULL };
 static const char *const projection_names[] = { "laplacian", "consistent", NULL };
 static const char *const pressure_stabilisation_names[] = { "none", "second_difference", NULL };
+static const char *const free_surface_names[] = { "nodes", "interpolated", NULL };
 static const char *const stabilisation_names[] = { "none", "fbar", "modified_fbar", "modified_fbar_cellwise",
 							   NULL };
 static const char *const permeability_law_names[] = { "constant", "kozeny_carman", "volume_ratio",
@@ -78,7 +81,8 @@ static const char *const top_keys[] = { "schema", "title", "formulation", "grid"
 static const char *const formulation_keys[] = { "scheme", "phases", "shape", "pore_pressure_smoothing",
 						"flip_fraction", "pressure_projection", "soil_stabilisation",
 						"drag_in_correction", "pressure_stabilisation",
-						"pressure_stabilisation_factor", NULL };
+						"pressure_stabilisation_factor", "free_surface",
+						"free_surface_penalty_factor", NULL };
 static const char *const grid_keys[] = { "origin", "extent", "cell_size", NULL };
 /* A material's own keys; its model's keys are checked by case_read_material_model(). */
 static const char *const material_keys[] = { "name", "density", NULL };
@@ -260,6 +264,13 @@ static void read_formulation(struct case_reader *r, const json_t *root, struct c
 		case_problem(r, "/formulation/pressure_stabilisation",
 			     "\"%s\" needs /formulation/pressure_projection \"consistent\"",
 			     pressure_stabilisation_names[f->pressure_stabilisation]);
+	f->free_surface = read_choice_or(r, o, p, "free_surface", CASE_OPTIONAL, free_surface_names, f->free_surface);
+	case_read_number(r, o, p, "free_surface_penalty_factor", CASE_OPTIONAL, &POSITIVE,
+			 &f->free_surface_penalty_factor);
+	/* measured to spoil the Laplacian's Terzaghi column eightfold (docs/numerics.md, "Free surface") */
+	if (f->free_surface != FREE_SURFACE_NODES && f->pressure_projection != PROJECTION_CONSISTENT)
+		case_problem(r, "/formulation/free_surface", "\"%s\" needs /formulation/pressure_projection \"consistent\"",
+			     free_surface_names[f->free_surface]);
 }
 
 /* Checks that extent[d] is a whole number, at least GRID_CELLS_MIN, of cells. */
@@ -675,6 +686,8 @@ static void set_defaults(struct case_spec *c)
 	c->formulation.drag_in_correction = 0;
 	c->formulation.pressure_stabilisation = PRESSURE_STABILISATION_NONE;
 	c->formulation.pressure_stabilisation_factor = DEFAULT_PRESSURE_STABILISATION_FACTOR;
+	c->formulation.free_surface = FREE_SURFACE_NODES;
+	c->formulation.free_surface_penalty_factor = DEFAULT_FREE_SURFACE_PENALTY_FACTOR;
 	c->fluid.density = DEFAULT_FLUID_DENSITY;
 	c->fluid.bulk_modulus = DEFAULT_FLUID_BULK_MODULUS;
 	c->gravity.acceleration[0] = 0;

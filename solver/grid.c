@@ -54,7 +54,7 @@ enum poro_status grid_fields_init(struct grid_fields *f, const struct grid *g, s
 	GRID_DOUBLE_FIELDS(ALLOC)
 #undef ALLOC
 	if (ok)
-		ok = (f->cell_wet = calloc((size_t)g->cell_count, 1)) && (f->dirichlet = calloc(n, 1)) &&
+		ok = (f->cell_wet = calloc((size_t)g->cell_count, 1)) && (f->dirichlet = calloc(n, 1)) && (f->surface = calloc(n, 1)) &&
 		     (f->fix_s = calloc(n, 1)) && (f->fix_w = calloc(n, 1));
 	if (!ok) {
 		grid_fields_release(f);
@@ -72,6 +72,7 @@ void grid_fields_release(struct grid_fields *f)
 #undef FREE
 	free(f->cell_wet);
 	free(f->dirichlet);
+	free(f->surface);
 	free(f->fix_s);
 	free(f->fix_w);
 	memset(f, 0, sizeof *f);

@@ -18,22 +18,10 @@
  *    Equal-order B-splines leave a node-to-node pressure pattern nearly outside A's reach; the
  *    case may hold it down with formulation.pressure_stabilisation (pressure_stabilisation.c).
  *
- * Boundary conditions: impermeable faces need nothing (the natural condition of Eq. 32). Nodes
- * on the free water surface and on drained faces get p^{t+1} = 0, i.e. dp_I = -p^t_I. A node is
- * on the free surface when a cell next to it (inside the grid) is not full: the volumes of the
- * water points in it add up to less than FREE_SURFACE_FILL of the cell (after Kularathna and Soga,
- * cited in 000 step 5b; a water point's volume is that of the mixture it fills, Eq. 36, so a
- * saturated cell is full). In double point a cell is also full when its soil points fill it and
- * it lies below a cell full of water in its column: the soil is saturated up to the top of its
- * water (000 §2), so cells that water points have left inside the soil (next to a drained face,
- * where they flow out, or where they gather into rows) still count, while soil above the water's
- * top (the gap of 000 Figs. 9-10, where water has drained out of the top of a slope) does not, and
- * the water's own surface is the free surface. Counting all soil as saturated held that water up
- * by suction (down to -4.9 kPa under the landslides' crest, docs/examples.md); counting no soil
- * opened free-surface nodes inside the Xie-Leo column where its water points gather. Counting merely
- * occupied cells is not enough: a single expelled water point in the cell above the soil would
- * move the free surface a whole cell up. Beyond a grid face where the water is unconstrained lies
- * open air, so the cells there count as dry; beyond a wall, they do not count.
+ * Boundary conditions: impermeable faces need nothing (the natural condition of Eq. 32). Where
+ * the pressure is zero, on the free water surface and on drained faces, free_surface.c decides,
+ * and how it is held: prescribed nodes get p^{t+1} = 0, i.e. dp_I = -p^t_I; with the
+ * interpolated condition its penalty is added to the matrix once the unknowns are numbered.
  */
 #include <assert.h>
 #include <stdlib.h>
@@ -43,11 +31,8 @@
 #include "sim_internal.h"
 #include "transfer.h"
 
-/* A cell is full (below the free surface) when its points' volumes reach this fraction of it. */
-#define FREE_SURFACE_FILL 0.5
-
 enum poro_status pressure_system_init(struct pressure_system *ps, const struct grid *g, int support,
-				      enum pressure_projection projection, struct poro_error *err)
+				      enum pressure_projection projection, int surface_points, struct poro_error *err)
 {
 	memset(ps, 0, sizeof *ps);
 	ps->exact = projection == PROJECTION_CONSISTENT;
@@ -70,8 +55,11 @@ enum poro_status pressure_system_init(struct pressure_system *ps, const struct g
 	ps->x = malloc(nodes * sizeof(double));
 	ps->diagonal = malloc(nodes * sizeof(double));
 	ps->interior = malloc(nodes);
+	/* at most two surface points on each of a full cell's four faces */
+	ps->sample_max = surface_points ? 8 * (idx_t)g->cell_count : 0;
+	ps->samples = surface_points ? malloc(2 * (size_t)ps->sample_max * sizeof(double)) : NULL;
 	if (!ps->stencil || !ps->grad_s || !ps->grad_w || !ps->coupling || !ps->unknown || !ps->colptr || !ps->rowidx ||
-	    !ps->values || !ps->b || !ps->x || !ps->diagonal || !ps->interior) {
+	    !ps->values || !ps->b || !ps->x || !ps->diagonal || !ps->interior || (surface_points && !ps->samples)) {
 		pressure_system_release(ps);
 		return poro_error_set(err, PORO_ENOMEM, "cannot allocate the pressure system");
 	}
@@ -92,71 +80,9 @@ void pressure_system_release(struct pressure_system *ps)
 	free(ps->x);
 	free(ps->diagonal);
 	free(ps->interior);
+	free(ps->samples);
 	spd_solver_destroy(&ps->solver);
 	memset(ps, 0, sizeof *ps);
-}
-
-/* fill[c] = the summed volumes of the points of p in cell c (points outside the grid left out). */
-static void cell_volumes(const struct grid *g, const struct particles *p, double *fill)
-{
-	memset(fill, 0, sizeof(double) * (size_t)g->cell_count);
-	for (idx_t q = 0; q < p->n; q++) {
-		idx_t c = grid_cell_of(g, p->x + 2 * q);
-		if (c >= 0)
-			fill[c] += p->volume[q];
-	}
-}
-
-/* Free surface and drained faces: marks f->dirichlet (see the file comment). */
-void pressure_mark_dirichlet(struct sim *s)
-{
-	const struct grid *g = &s->grid;
-	struct grid_fields *f = &s->f;
-	const struct particles *w = &s->water;
-	/* a cell is full if its water points fill it, or its soil points below its column's water */
-	const double full = FREE_SURFACE_FILL * g->h * g->h;
-	const struct case_boundary *bc = s->spec->boundaries;
-	/* beyond a face where water moves freely is open air (dry); beyond a wall, nothing */
-	const int open[FACE_COUNT] = {bc[FACE_LEFT].water == CONSTRAINT_FREE, bc[FACE_RIGHT].water == CONSTRAINT_FREE,
-				      bc[FACE_BOTTOM].water == CONSTRAINT_FREE, bc[FACE_TOP].water == CONSTRAINT_FREE};
-	double *fill = s->cell_fill;
-	cell_volumes(g, w, fill);
-	for (idx_t c = 0; c < g->cell_count; c++)
-		f->cell_wet[c] = fill[c] >= full;
-	if (s->double_point) {
-		/* saturated soil fills a cell below the top of its column's water (file comment) */
-		cell_volumes(g, &s->soil, fill);
-		for (idx_t ci = 0; ci < g->cells[0]; ci++) {
-			int below_water = 0;
-			for (idx_t cj = g->cells[1] - 1; cj >= 0; cj--) {
-				idx_t c = ci + cj * g->cells[0];
-				below_water |= f->cell_wet[c];
-				f->cell_wet[c] |= below_water && fill[c] >= full;
-			}
-		}
-	}
-	for (idx_t j = 0; j < g->nodes[1]; j++)
-		for (idx_t i = 0; i < g->nodes[0]; i++) {
-			int dry = 0;
-			for (idx_t cj = j - 1; cj <= j; cj++)
-				for (idx_t ci = i - 1; ci <= i; ci++) {
-					if (ci >= 0 && cj >= 0 && ci < g->cells[0] && cj < g->cells[1])
-						dry |= !f->cell_wet[ci + cj * g->cells[0]];
-					else
-						dry |= (ci < 0 && open[FACE_LEFT]) || (ci >= g->cells[0] && open[FACE_RIGHT]) ||
-						       (cj < 0 && open[FACE_BOTTOM]) || (cj >= g->cells[1] && open[FACE_TOP]);
-				}
-			f->dirichlet[grid_node(g, i, j)] = (signed char)dry;
-		}
-	for (idx_t j = 0; j < g->nodes[1]; j++)
-		for (idx_t i = 0; i < g->nodes[0]; i++) {
-			int drained = (i == 0 && bc[FACE_LEFT].drainage == DRAINAGE_DRAINED) ||
-				      (i == g->cells[0] && bc[FACE_RIGHT].drainage == DRAINAGE_DRAINED) ||
-				      (j == 0 && bc[FACE_BOTTOM].drainage == DRAINAGE_DRAINED) ||
-				      (j == g->cells[1] && bc[FACE_TOP].drainage == DRAINAGE_DRAINED);
-			if (drained)
-				f->dirichlet[grid_node(g, i, j)] = 1;
-		}
 }
 
 /* Adds sum_p coef_p grad S_Ip . grad S_Jp into the stencil (Eq. 61). */
@@ -380,9 +306,10 @@ static void assemble_rhs(struct sim *s)
 	memset(sum_w, 0, sizeof(double) * (size_t)g->node_count);
 }
 
-/* Numbers the unknowns and builds the upper triangle of L in CSC; moves prescribed values to b.
- * The system solved is L dp = (D_s v_s* + D_w v_w*) / dt, Eq. 60 divided by dt. */
-static idx_t build_reduced_system(struct sim *s)
+/* Numbers the unknowns, adds the interpolated free-surface condition (free_surface.c) with its
+ * weight scaled by `diagonal_mean`, and builds the upper triangle of L in CSC; moves prescribed
+ * values to b. The system solved is L dp = (D_s v_s* + D_w v_w*) / dt, Eq. 60 divided by dt. */
+static idx_t build_reduced_system(struct sim *s, double diagonal_mean)
 {
 	const struct grid *g = &s->grid;
 	struct grid_fields *f = &s->f;
@@ -402,6 +329,7 @@ static idx_t build_reduced_system(struct sim *s)
 		 * faces several times faster than Darcy's law */
 		f->dp[I] = active && f->dirichlet[I] && !remap ? -f->pressure[I] : 0.0;
 	}
+	free_surface_add_penalty(s, diagonal_mean);
 	idx_t nnz = 0;
 	for (idx_t J = 0; J < g->node_count; J++) {
 		idx_t col = ps->unknown[J];
@@ -430,16 +358,33 @@ static idx_t build_reduced_system(struct sim *s)
 	return n;
 }
 
+/* The mean of the matrix's positive diagonal entries: the scale of the surface penalty. */
+static double mean_diagonal(const struct sim *s)
+{
+	const struct pressure_system *ps = &s->ps;
+	const int W = ps->width, centre = ps->radius + ps->radius * W;
+	double sum = 0.0;
+	idx_t count = 0;
+	for (idx_t I = 0; I < s->grid.node_count; I++) {
+		const double d = ps->stencil[(size_t)I * W * W + centre];
+		if (d > 0.0)
+			sum += d, count++;
+	}
+	return count ? sum / (double)count : 0.0;
+}
+
 enum poro_status pressure_solve(struct sim *s)
 {
 	struct pressure_system *ps = &s->ps;
 	const struct particles *p = &s->soil, *w = &s->water;
 	double t0 = sim_clock();
 	memset(ps->stencil, 0, sizeof(double) * (size_t)s->grid.node_count * ps->width * ps->width);
-	pressure_mark_dirichlet(s);
+	free_surface_mark(s);
+	double diagonal_mean = 0.0;
 	if (ps->exact) {
 		memset(s->f.rhs, 0, sizeof(double) * (size_t)s->grid.node_count);
 		assemble_exact_projection(s);
+		diagonal_mean = mean_diagonal(s);   /* before any penalty */
 		pressure_stabilise(s);   /* pressure_stabilisation.c */
 	} else {
 		for (idx_t q = 0; q < p->n; q++) {
@@ -454,7 +399,7 @@ enum poro_status pressure_solve(struct sim *s)
 		assemble_laplacian(s, w, s->water_coef);
 		assemble_rhs(s);
 	}
-	idx_t n = build_reduced_system(s);
+	idx_t n = build_reduced_system(s, diagonal_mean);
 	double t1 = sim_clock();
 	s->phase_seconds[PHASE_PRESSURE_ASSEMBLY] += t1 - t0;
 	enum poro_status st = spd_solver_solve(ps->solver, n, ps->colptr, ps->rowidx, ps->values, ps->b,

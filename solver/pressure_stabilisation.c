@@ -31,7 +31,9 @@
 #include "sim_internal.h"
 
 /* Marks the nodes whose neighbourhood of radius `margin` (inside the grid) holds only pressure
- * unknowns: active (positive diagonal) and not prescribed. */
+ * unknowns away from the surface: active (positive diagonal), not prescribed, and not holding the
+ * interpolated free-surface condition (free_surface.c), where the pressure drops to zero within
+ * a cell as it does next to a prescribed node. */
 static void mark_interior(const struct sim *s, const double *diagonal, int margin, signed char *interior)
 {
 	const struct grid *g = &s->grid;
@@ -42,7 +44,8 @@ static void mark_interior(const struct sim *s, const double *diagonal, int margi
 		for (idx_t b = j - margin; inside && b <= j + margin; b++)
 			for (idx_t a = i - margin; inside && a <= i + margin; a++)
 				if (a >= 0 && a < nx && b >= 0 && b < ny)
-					inside = diagonal[a + b * nx] > 0.0 && !s->f.dirichlet[a + b * nx];
+					inside = diagonal[a + b * nx] > 0.0 && !s->f.dirichlet[a + b * nx] &&
+						 !s->f.surface[a + b * nx];
 		interior[K] = (signed char)inside;
 	}
 }

@@ -138,11 +138,12 @@ static enum poro_status allocate_scratch(struct sim *s)
 	s->water_scalar = calloc(nw, sizeof(double));
 	s->water_coef = calloc(nw, sizeof(double));
 	s->cell_fill = calloc((size_t)s->grid.cell_count, sizeof(double));
+	s->cell_fill_soil = calloc((size_t)s->grid.cell_count, sizeof(double));
 	s->patch_mass = calloc((size_t)s->grid.cell_count, sizeof(double));
 	s->patch_mass_Je = calloc((size_t)s->grid.cell_count, sizeof(double));
 	s->probe_point = calloc((size_t)s->spec->probe_count + 1, sizeof(int));
 	if (!s->soil_grad || !s->soil_scalar || !s->soil_coef || !s->water_vec || !s->water_scalar ||
-	    !s->water_coef || !s->cell_fill || !s->patch_mass || !s->patch_mass_Je || !s->probe_point)
+	    !s->water_coef || !s->cell_fill || !s->cell_fill_soil || !s->patch_mass || !s->patch_mass_Je || !s->probe_point)
 		return poro_error_set(&s->err, PORO_ENOMEM, "cannot allocate step workspaces");
 	return PORO_OK;
 }
@@ -169,8 +170,8 @@ static enum poro_status build(struct sim *s)
 	if ((st = init_water(s)) || (st = allocate_scratch(s)))
 		return st;
 	stabilisation_patches_init(s);
-	if ((st = pressure_system_init(&s->ps, &s->grid, s->soil.support,
-					      c->formulation.pressure_projection, &s->err)))
+	if ((st = pressure_system_init(&s->ps, &s->grid, s->soil.support, c->formulation.pressure_projection,
+				       c->formulation.free_surface == FREE_SURFACE_INTERPOLATED, &s->err)))
 		return st;
 	boundary_mark(s);
 	loads_init(s);
@@ -217,6 +218,7 @@ void sim_destroy(struct sim **ps)
 	free(s->water_scalar);
 	free(s->water_coef);
 	free(s->cell_fill);
+	free(s->cell_fill_soil);
 	free(s->patch_mass);
 	free(s->patch_mass_Je);
 	free(s->probe_point);

@@ -31,6 +31,9 @@ struct pressure_system {
 	idx_t *colptr, *rowidx;   /* CSC upper triangle of the reduced system */
 	double *values, *b, *x;
 	double *diagonal;         /* [node_count] A's diagonal before the pressure stabilisation */
+	double *samples;          /* [2 sample_max] x, y of the interpolated free-surface condition's
+				     surface points (free_surface.c), m; NULL with the nodal condition */
+	idx_t sample_count, sample_max;
 	signed char *interior;    /* [node_count] 1: the stabilisation may act on the node */
 	struct spd_solver *solver;
 };
@@ -56,6 +59,7 @@ struct sim {
 	double *water_scalar;         /* [n_water] */
 	double *water_coef;           /* [n_water] */
 	double *cell_fill;            /* [cell_count] volume of pressure-carrying points per cell, m^3/m */
+	double *cell_fill_soil;       /* [cell_count] volume of soil points per cell (double point), m^3/m */
 
 	/* Patches of the modified F-bar (000 Eq. 83): a fixed tiling of the grid into
 	 * patches[0] x patches[1] rectangles of patch_width (about h_patch; see semi_implicit.c) */
@@ -82,16 +86,24 @@ enum poro_status semi_implicit_step(struct sim *s);
 void stabilisation_patches_init(struct sim *s);
 
 /* pressure.c: free-surface detection and the Poisson solve (000 §4.5 step 5). */
+/* surface_points: room for the interpolated free-surface condition's points (free_surface.c). */
 enum poro_status pressure_system_init(struct pressure_system *ps, const struct grid *g, int support,
-				      enum pressure_projection projection, struct poro_error *err);
+				      enum pressure_projection projection, int surface_points, struct poro_error *err);
 void pressure_system_release(struct pressure_system *ps);
-void pressure_mark_dirichlet(struct sim *s);
 enum poro_status pressure_solve(struct sim *s);
 /* Adds the case's pressure stabilisation to the assembled consistent projection (stencil and
  * right-hand side); nothing when the case has none. pressure_stabilisation.c. */
 void pressure_stabilise(struct sim *s);
 void pressure_gradient_operators(struct sim *s);
 void pressure_apply_gradient(const struct sim *s, const double *G, const double *pressure, double *out);
+
+/* free_surface.c: where p^{t+1} = 0 (000 §4.5 step 5b). free_surface_mark sets f->cell_wet,
+ * f->dirichlet (prescribed nodes), f->surface and the surface points of the interpolated
+ * condition; free_surface_add_penalty adds that condition's penalty, weighted by
+ * free_surface_penalty_factor * scale, to the stencil and f->rhs among the numbered unknowns
+ * (nothing with the nodal condition). */
+void free_surface_mark(struct sim *s);
+void free_surface_add_penalty(struct sim *s, double scale);
 
 /* boundary.c: velocity constraints of the grid faces (000 §4.5 steps 3e, 4d, 6d). */
 void boundary_mark(struct sim *s);

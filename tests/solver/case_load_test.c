@@ -182,6 +182,8 @@ static void test_minimal_defaults(const struct case_spec *c)
 	CHECK(f->pressure_stabilisation == PRESSURE_STABILISATION_NONE && f->pressure_stabilisation_factor == 10,
 	      "default pressure stabilisation", "kind %d factor %g", f->pressure_stabilisation,
 	      f->pressure_stabilisation_factor);
+	CHECK(f->free_surface == FREE_SURFACE_NODES && f->free_surface_penalty_factor == 1e4, "default free surface",
+	      "kind %d factor %g", f->free_surface, f->free_surface_penalty_factor);
 	CHECK(c->bodies[0].permeability_law == PERMEABILITY_CONSTANT, "default permeability law", "got %d",
 	      c->bodies[0].permeability_law);
 	CHECK(c->fluid.density == 1000 && c->fluid.bulk_modulus == 2.2e9, "default fluid",
@@ -357,6 +359,25 @@ static void test_out_of_range(void)
 		      c->formulation.pressure_stabilisation_factor == 2.385, "pressure stabilisation read",
 		      "kind %d factor %g", c ? (int)c->formulation.pressure_stabilisation : -1,
 		      c ? c->formulation.pressure_stabilisation_factor : 0.0);
+		case_destroy(&c);
+		free(text);
+	}
+	expect_invalid("interpolated free surface without the consistent projection", "/formulation/free_surface",
+		       "\"interpolated\"",
+		       "/formulation/free_surface: \"interpolated\" needs /formulation/pressure_projection \"consistent\"");
+	expect_invalid("unknown free surface", "/formulation/free_surface", "\"cells\"",
+		       "/formulation/free_surface: must be one of 'nodes', 'interpolated', got 'cells'");
+	expect_invalid("free surface penalty factor negative", "/formulation/free_surface_penalty_factor", "-1e4",
+		       "/formulation/free_surface_penalty_factor: must be > 0, got -10000");
+	{
+		const struct edit e[] = { { "/formulation/pressure_projection", "\"consistent\"" },
+					  { "/formulation/free_surface", "\"interpolated\"" },
+					  { "/formulation/free_surface_penalty_factor", "385.2" } };
+		char *text = edited(full_case, e, 3);
+		struct case_spec *c = load_valid("interpolated free surface with the consistent projection", text);
+		CHECK(c && c->formulation.free_surface == FREE_SURFACE_INTERPOLATED &&
+		      c->formulation.free_surface_penalty_factor == 385.2, "free surface read", "kind %d factor %g",
+		      c ? (int)c->formulation.free_surface : -1, c ? c->formulation.free_surface_penalty_factor : 0.0);
 		case_destroy(&c);
 		free(text);
 	}

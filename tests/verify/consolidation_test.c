@@ -11,7 +11,9 @@
  *  e. soil and water mass conserved to 1e-12 relative at every step, and the grid masses
  *     equal the point masses (partition of unity of the transfer);
  *  and the second-difference pressure stabilisation on the k = 1e-9 column with the consistent
- *  projection: the node-to-node pressure pattern gone, the column not drained by it.
+ *  projection: the node-to-node pressure pattern gone, the column not drained by it; and the
+ *  interpolated free-surface condition (free_surface.c): the Terzaghi errors with it, and the
+ *  k = 1e-9 column's interior held at q for 2,000 steps.
  * Each figure is printed on an INFO line before the check that asserts it.
  */
 #include <string.h>
@@ -27,6 +29,7 @@
 #define MASS_TOL 1e-12
 
 static int consistent_projection;   /* run columns with formulation.pressure_projection "consistent" */
+static int interpolated_surface;    /* and with formulation.free_surface "interpolated" */
 
 struct column {
 	double H, q, k, rho_w, mv, dt;
@@ -108,6 +111,8 @@ static int run_column(const char *file, double cell_size, double dt, const char 
 		c->time.dt = dt;
 	if (consistent_projection)
 		c->formulation.pressure_projection = PROJECTION_CONSISTENT;
+	if (interpolated_surface)
+		c->formulation.free_surface = FREE_SURFACE_INTERPOLATED;
 	if (phases)
 		c->formulation.phases = !strcmp(phases, "single_point") ? PHASES_SINGLE_POINT : PHASES_DOUBLE_POINT;
 	struct sim *s = NULL;
@@ -203,6 +208,22 @@ static void check_low_permeability(void)
 	case_destroy(&c);
 }
 
+/* The k = 1e-9 column under the consistent projection with drag in the correction, with or
+ * without the second-difference stabilisation and the interpolated free surface. Returns 1 and
+ * the case and simulation, or 0 with err set. */
+static int create_low_permeability_consistent(int stabilised, int interpolated, struct case_spec **c,
+					      struct sim **s, struct poro_error *err)
+{
+	if (case_load_file(CASES "terzaghi_low_permeability.json", c, err))
+		return 0;
+	(*c)->formulation.pressure_projection = PROJECTION_CONSISTENT;
+	(*c)->formulation.drag_in_correction = 1;
+	(*c)->formulation.pressure_stabilisation = stabilised ? PRESSURE_STABILISATION_SECOND_DIFFERENCE
+							      : PRESSURE_STABILISATION_NONE;
+	(*c)->formulation.free_surface = interpolated ? FREE_SURFACE_INTERPOLATED : FREE_SURFACE_NODES;
+	return !sim_create(s, *c, err);
+}
+
 /* The k = 1e-9 column with the consistent projection and drag in the correction, 2,000 steps:
  * *wiggle = the largest second difference of the row means of the pore pressure between point
  * rows below the top STABILISATION_MARGIN_CELLS cells (a smooth profile gives about 0, the
@@ -215,14 +236,7 @@ static int run_low_permeability_consistent(int stabilised, double *wiggle, doubl
 	struct case_spec *c = NULL;
 	struct poro_error err = {0};
 	struct sim *s = NULL;
-	int ok = !case_load_file(CASES "terzaghi_low_permeability.json", &c, &err);
-	if (ok) {
-		c->formulation.pressure_projection = PROJECTION_CONSISTENT;
-		c->formulation.drag_in_correction = 1;
-		c->formulation.pressure_stabilisation = stabilised ? PRESSURE_STABILISATION_SECOND_DIFFERENCE
-								   : PRESSURE_STABILISATION_NONE;
-		ok = !sim_create(&s, c, &err);
-	}
+	int ok = create_low_permeability_consistent(stabilised, 0, &c, &s, &err);
 	for (long k = 0; ok && k < 2000; k++)
 		ok = !sim_step(s);
 	if (!ok) {
@@ -285,30 +299,85 @@ static void check_pressure_stabilisation(void)
 	      "mean sigma'_yy %.4f q with, %.4f q without", stress_on, stress_off);
 }
 
-/* The consistent projection on the single-point column: errors and their fall with h. */
-static void check_consistent_projection(void)
+/* The consistent projection on the single-point column, with the nodal or the interpolated
+ * free-surface condition: errors and their fall with h. */
+static void check_consistent_projection(int interpolated)
 {
 	const double Tv[4] = {0.1, 0.2, 0.5, 1.0};
+	const char *label = interpolated ? "consistent projection, interpolated free surface" : "consistent projection";
+	const char *tag = interpolated ? "terzaghi_consistent_interpolated_surface" : "terzaghi_consistent_projection";
 	double rms[4] = {0}, fine[4] = {0}, drift, grid_err;
-	consistent_projection = 1;
+	consistent_projection = 1, interpolated_surface = interpolated;
 	int ok = run_column(CASES "terzaghi_single_point.json", 0, 0, NULL, Tv, 4, rms, &drift, &grid_err) &&
 		 run_column(CASES "terzaghi_single_point.json", 0.0125, 0.5e-4, NULL, Tv, 2, fine, &drift, &grid_err);
-	consistent_projection = 0;
+	consistent_projection = interpolated_surface = 0;
 	double worst = 0, coarse_mean = 0, fine_mean = 0;
 	for (int i = 0; i < 4; i++) {
-		printf("INFO terzaghi single_point consistent projection Tv=%.1f rms/q=%.5f (h)\n", Tv[i], rms[i]);
+		printf("INFO terzaghi single_point %s Tv=%.1f rms/q=%.5f (h)\n", label, Tv[i], rms[i]);
 		worst = fmax(worst, rms[i]);
 	}
 	for (int i = 0; i < 2; i++) {
-		printf("INFO terzaghi single_point consistent projection Tv=%.1f rms/q=%.5f (h/2)\n", Tv[i], fine[i]);
+		printf("INFO terzaghi single_point %s Tv=%.1f rms/q=%.5f (h/2)\n", label, Tv[i], fine[i]);
 		coarse_mean += rms[i] / 2, fine_mean += fine[i] / 2;
 	}
-	CHECK(ok && worst <= 0.02, "terzaghi_consistent_projection_rms_below_2pct", "worst rms/q %.5f", worst);
-	CHECK(ok && fine_mean < coarse_mean, "terzaghi_consistent_projection_error_falls_with_h",
-	      "mean rms/q at Tv 0.1-0.2 %.5f (h) vs %.5f (h/2)", coarse_mean, fine_mean);
+	char name[128];
+	snprintf(name, sizeof name, "%s_rms_below_2pct", tag);
+	CHECK(ok && worst <= 0.02, name, "worst rms/q %.5f", worst);
+	snprintf(name, sizeof name, "%s_error_falls_with_h", tag);
+	CHECK(ok && fine_mean < coarse_mean, name, "mean rms/q at Tv 0.1-0.2 %.5f (h) vs %.5f (h/2)", coarse_mean,
+	      fine_mean);
 }
 
-/* With an argument, runs only the named group (double_point, single_point, drained, low_k). */
+/* The k = 1e-9 column under the consistent projection with drag, the second-difference
+ * stabilisation and the interpolated free-surface condition (free_surface.c), 2,000 steps: the
+ * mean pressure of the middle half of the column from the second step on (the first is the
+ * sudden load's, within 3%: free_surface_test), and the range over all points. The middle stays
+ * at q; within three cells of the surface the pressure still swings (up to about 1.46 q), which
+ * requirement c's bound on every point does not allow (the XFAIL above, for the case as written). */
+#define LOW_K_INTERIOR_TOLERANCE 0.01   /* q (measured 0.997-1.001) */
+static void check_low_permeability_interpolated(void)
+{
+	struct case_spec *c = NULL;
+	struct poro_error err = {0};
+	struct sim *s = NULL;
+	int ok = create_low_permeability_consistent(1, 1, &c, &s, &err);
+	const double q = ok ? -c->loads[0].traction[1] : 1, H = ok ? c->bodies[0].max[1] : 1;
+	double mid_min = INFINITY, mid_max = -INFINITY, pmin = INFINITY, pmax = -INFINITY;
+	idx_t n = ok ? sim_pressure_point_count(s) : 0;
+	double *p = malloc(sizeof *p * (size_t)(n + 1)), *xy = malloc(sizeof *xy * 2 * (size_t)(n + 1));
+	for (long k = 0; ok && k < 2000; k++) {
+		ok = !sim_step(s) && p && xy;
+		if (!ok)
+			break;
+		sim_pore_pressure(s, p, xy);
+		double sum = 0;
+		idx_t count = 0;
+		for (idx_t i = 0; i < n; i++) {
+			if (!isfinite(p[i]))
+				ok = 0;
+			pmin = fmin(pmin, p[i]), pmax = fmax(pmax, p[i]);
+			if (xy[2 * i + 1] > 0.25 * H && xy[2 * i + 1] < 0.75 * H)
+				sum += p[i], count++;
+		}
+		if (k > 0)
+			mid_min = fmin(mid_min, sum / count / q), mid_max = fmax(mid_max, sum / count / q);
+	}
+	printf("INFO k=1e-9 consistent projection with drag, stabilisation and the interpolated free surface, 2,000 "
+	       "steps: mean pore pressure of the middle half %.4f-%.4f q (steps 2-2000); all points %.4f-%.4f q\n",
+	       mid_min, mid_max, pmin / q, pmax / q);
+	if (!ok)
+		printf("INFO the run failed: %s\n", s ? sim_error(s)->message : err.message);
+	CHECK(ok && fabs(mid_min - 1) <= LOW_K_INTERIOR_TOLERANCE && fabs(mid_max - 1) <= LOW_K_INTERIOR_TOLERANCE,
+	      "low_permeability_interpolated_surface_interior_at_q", "%.4f-%.4f q", mid_min, mid_max);
+	CHECK(ok && pmin >= 0, "low_permeability_interpolated_surface_pressure_non_negative", "minimum %.4f q",
+	      pmin / q);
+	free(p), free(xy);
+	sim_destroy(&s);
+	case_destroy(&c);
+}
+
+/* With an argument, runs only the named group (double_point, single_point, drained, low_k,
+ * consistent, stabilisation, free_surface). */
 int main(int argc, char **argv)
 {
 	const char *only = argc > 1 ? argv[1] : NULL;
@@ -322,7 +391,11 @@ int main(int argc, char **argv)
 	if (WANT("low_k"))
 		check_low_permeability();
 	if (WANT("consistent"))
-		check_consistent_projection();
+		check_consistent_projection(0);
+	if (WANT("free_surface")) {
+		check_consistent_projection(1);
+		check_low_permeability_interpolated();
+	}
 	if (WANT("stabilisation"))
 		check_pressure_stabilisation();
 	HARNESS_EXIT();

@@ -1,0 +1,226 @@
+/*
+ * free_surface.c - where the pore pressure is zero (000 §4.5 step 5b): the free water surface
+ * and drained faces, and the two ways the pressure solve holds p^{t+1} = 0 there
+ * (formulation.free_surface).
+ *
+ * Where the surface is. A cell is full (below the free surface) when the volumes of the water
+ * points in it reach FREE_SURFACE_FILL of it (after Kularathna and Soga, cited in 000 step 5b; a
+ * water point's volume is that of the mixture it fills, Eq. 36, so a saturated cell is full). In
+ * double point a cell is also full when its soil points fill it and it lies below a cell full of
+ * water in its column: the soil is saturated up to the top of its water (000 §2), so cells that
+ * water points have left inside the soil (next to a drained face, where they flow out, or where
+ * they gather into rows) still count, while soil above the water's top (the gap of 000 Figs.
+ * 9-10, where water has drained out of the top of a slope) does not, and the water's own surface
+ * is the free surface. Counting all soil as saturated held that water up by suction (down to
+ * -4.9 kPa under the landslides' crest, docs/examples.md); counting no soil opened free-surface
+ * nodes inside the Xie-Leo column where its water points gather. Counting merely occupied cells is
+ * not enough: a single expelled water point in the cell above the soil would move the free
+ * surface a whole cell up. Beyond a grid face where the water is unconstrained lies open air, so
+ * the cells there count as dry; beyond a wall, they do not count.
+ *
+ * How p = 0 is held there.
+ *  - "nodes" (default, the paper's step 5b): every node next to a cell that is not full gets
+ *    p^{t+1} = 0, as do the nodes of drained faces.
+ *  - "interpolated" (consistent projection only): the nodes on a face between a full cell and a
+ *    dry one become unknowns, and the interpolated pressure sum_J S_J(x) p^{t+1}_J is driven to
+ *    zero at points x on the surface by a penalty in the energy the projection minimises,
+ *        (beta / 2) sum_x (sum_J S_J(x) p^{t+1}_J)^2,   beta = free_surface_penalty_factor * mean A_II,
+ *    which keeps the matrix symmetric positive definite for CHOLMOD. Why: B-splines do not
+ *    interpolate, so with the surface node at 0 the field itself still stands at about an
+ *    eighth of the interior pressure at the surface (quadratic: 1 - 3/4 - 1/8 of it). The
+ *    pressure force sum_p V_p S_Ip grad p(x_p) integrates the drop between the interior and the
+ *    surface exactly (midpoint rule on a linear gradient), so it sees only that part of the drop,
+ *    and the interior pressure rises until the part seen carries the load: the middle half of
+ *    the k = 1e-9 m/s Terzaghi column stands at 1.15-1.28 q over 2,000 steps under the
+ *    consistent projection, at 0.997-1.003 q with the condition (docs/numerics.md, "Free
+ *    surface"). Nodes farther out stay at 0.
+ *    The surface points: two Gauss points on each such face, moved along its normal to where the
+ *    two cells' fill puts a surface parallel to it: a full cell next to one filled to f puts it
+ *    f h beyond the face, a cell filled to f_wet < 1 next to an empty one (1 - f_wet) h inside;
+ *    in general (f_wet + f_dry - 1) h, kept within half a cell. Drained grid faces keep their
+ *    nodes at 0 and get no surface points (the B-splines interpolate at the grid edge).
+ */
+#include <assert.h>
+#include <math.h>
+#include <string.h>
+
+#include "shape.h"
+#include "sim_internal.h"
+
+/* A cell is full (below the free surface) when its points' volumes reach this fraction of it. */
+#define FREE_SURFACE_FILL 0.5
+
+/* fill[c] = the summed volumes of the points of p in cell c (points outside the grid left out). */
+static void cell_volumes(const struct grid *g, const struct particles *p, double *fill)
+{
+	memset(fill, 0, sizeof(double) * (size_t)g->cell_count);
+	for (idx_t q = 0; q < p->n; q++) {
+		idx_t c = grid_cell_of(g, p->x + 2 * q);
+		if (c >= 0)
+			fill[c] += p->volume[q];
+	}
+}
+
+/* Node (i, j) lies on a grid face the case drains. */
+static int on_drained_face(const struct sim *s, idx_t i, idx_t j)
+{
+	const struct case_boundary *bc = s->spec->boundaries;
+	const struct grid *g = &s->grid;
+	return (i == 0 && bc[FACE_LEFT].drainage == DRAINAGE_DRAINED) ||
+	       (i == g->cells[0] && bc[FACE_RIGHT].drainage == DRAINAGE_DRAINED) ||
+	       (j == 0 && bc[FACE_BOTTOM].drainage == DRAINAGE_DRAINED) ||
+	       (j == g->cells[1] && bc[FACE_TOP].drainage == DRAINAGE_DRAINED);
+}
+
+/* f->cell_wet; s->cell_fill (water) and, double point, s->cell_fill_soil hold the volumes. */
+static void mark_full_cells(struct sim *s)
+{
+	const struct grid *g = &s->grid;
+	struct grid_fields *f = &s->f;
+	const double full = FREE_SURFACE_FILL * g->h * g->h;
+	cell_volumes(g, &s->water, s->cell_fill);
+	for (idx_t c = 0; c < g->cell_count; c++)
+		f->cell_wet[c] = s->cell_fill[c] >= full;
+	if (!s->double_point)
+		return;
+	/* saturated soil fills a cell below the top of its column's water (file comment) */
+	cell_volumes(g, &s->soil, s->cell_fill_soil);
+	for (idx_t ci = 0; ci < g->cells[0]; ci++) {
+		int below_water = 0;
+		for (idx_t cj = g->cells[1] - 1; cj >= 0; cj--) {
+			idx_t c = ci + cj * g->cells[0];
+			below_water |= f->cell_wet[c];
+			f->cell_wet[c] |= below_water && s->cell_fill_soil[c] >= full;
+		}
+	}
+}
+
+/* Cell (ci, cj), inside the grid or beyond a face, counts as dry: not full, or open air. */
+static int cell_dry(const struct sim *s, const int open[FACE_COUNT], idx_t ci, idx_t cj)
+{
+	const struct grid *g = &s->grid;
+	if (ci >= 0 && cj >= 0 && ci < g->cells[0] && cj < g->cells[1])
+		return !s->f.cell_wet[ci + cj * g->cells[0]];
+	return (ci < 0 && open[FACE_LEFT]) || (ci >= g->cells[0] && open[FACE_RIGHT]) ||
+	       (cj < 0 && open[FACE_BOTTOM]) || (cj >= g->cells[1] && open[FACE_TOP]);
+}
+
+/* How far cell (ci, cj) is filled, at most 1 (0 beyond the grid): by water, or for a full cell
+ * in double point by water or soil, whichever fills more. */
+static double cell_fraction(const struct sim *s, idx_t ci, idx_t cj)
+{
+	const struct grid *g = &s->grid;
+	if (ci < 0 || cj < 0 || ci >= g->cells[0] || cj >= g->cells[1])
+		return 0.0;
+	const idx_t c = ci + cj * g->cells[0];
+	double v = s->cell_fill[c];
+	if (s->double_point && s->f.cell_wet[c] && s->cell_fill_soil[c] > v)
+		v = s->cell_fill_soil[c];
+	return fmin(v / (g->h * g->h), 1.0);
+}
+
+/* The interpolated condition's surface points on the face between full cell (ci, cj) and its dry
+ * neighbour in direction (dx, dy), and the face's two nodes taken from the prescribed set. */
+static void add_surface_face(struct sim *s, idx_t ci, idx_t cj, int dx, int dy)
+{
+	const struct grid *g = &s->grid;
+	struct pressure_system *ps = &s->ps;
+	double d = cell_fraction(s, ci, cj) + cell_fraction(s, ci + dx, cj + dy) - 1.0;
+	d = fmax(-0.5, fmin(0.5, d));
+	const double cx = g->origin[0] + ((double)ci + 0.5 + 0.5 * dx + d * dx) * g->h;
+	const double cy = g->origin[1] + ((double)cj + 0.5 + 0.5 * dy + d * dy) * g->h;
+	const double gauss = g->h / (2.0 * sqrt(3.0));   /* two-point Gauss rule along the face */
+	for (int e = 0; e < 2; e++) {
+		assert(ps->sample_count < ps->sample_max);
+		double *x = ps->samples + 2 * ps->sample_count++;
+		const double t = e ? gauss : -gauss;
+		x[0] = cx + (dx == 0 ? t : 0.0);
+		x[1] = cy + (dy == 0 ? t : 0.0);
+	}
+	for (int e = 0; e < 2; e++) {
+		const idx_t i = ci + (dx ? dx > 0 : e), j = cj + (dy ? dy > 0 : e);
+		const idx_t I = grid_node(g, i, j);
+		if (s->f.dirichlet[I] && !on_drained_face(s, i, j)) {
+			s->f.dirichlet[I] = 0;
+			s->f.surface[I] = 1;
+		}
+	}
+}
+
+/* Places the interpolated condition on every face between a full cell and a dry one, except on
+ * drained grid faces. */
+static void place_surface(struct sim *s, const int open[FACE_COUNT])
+{
+	const struct grid *g = &s->grid;
+	static const int dir[FACE_COUNT][2] = {{-1, 0}, {1, 0}, {0, -1}, {0, 1}};   /* enum grid_face order */
+	for (idx_t cj = 0; cj < g->cells[1]; cj++)
+		for (idx_t ci = 0; ci < g->cells[0]; ci++) {
+			if (!s->f.cell_wet[ci + cj * g->cells[0]])
+				continue;
+			for (int k = 0; k < FACE_COUNT; k++) {
+				const idx_t ai = ci + dir[k][0], aj = cj + dir[k][1];
+				const int beyond = ai < 0 || aj < 0 || ai >= g->cells[0] || aj >= g->cells[1];
+				if (!cell_dry(s, open, ai, aj) ||
+				    (beyond && s->spec->boundaries[k].drainage == DRAINAGE_DRAINED))
+					continue;
+				add_surface_face(s, ci, cj, dir[k][0], dir[k][1]);
+			}
+		}
+}
+
+void free_surface_mark(struct sim *s)
+{
+	const struct grid *g = &s->grid;
+	struct grid_fields *f = &s->f;
+	const struct case_boundary *bc = s->spec->boundaries;
+	/* beyond a face where water moves freely is open air (dry); beyond a wall, nothing */
+	const int open[FACE_COUNT] = {bc[FACE_LEFT].water == CONSTRAINT_FREE, bc[FACE_RIGHT].water == CONSTRAINT_FREE,
+				      bc[FACE_BOTTOM].water == CONSTRAINT_FREE, bc[FACE_TOP].water == CONSTRAINT_FREE};
+	mark_full_cells(s);
+	for (idx_t j = 0; j < g->nodes[1]; j++)
+		for (idx_t i = 0; i < g->nodes[0]; i++) {
+			int dry = on_drained_face(s, i, j);
+			for (idx_t cj = j - 1; cj <= j; cj++)
+				for (idx_t ci = i - 1; ci <= i; ci++)
+					dry |= cell_dry(s, open, ci, cj);
+			f->dirichlet[grid_node(g, i, j)] = (signed char)dry;
+		}
+	memset(f->surface, 0, (size_t)g->node_count);
+	s->ps.sample_count = 0;
+	if (s->spec->formulation.free_surface == FREE_SURFACE_INTERPOLATED)
+		place_surface(s, open);
+}
+
+void free_surface_add_penalty(struct sim *s, double scale)
+{
+	const struct grid *g = &s->grid;
+	const struct grid_fields *f = &s->f;
+	struct pressure_system *ps = &s->ps;
+	const enum case_shape kind = s->spec->formulation.shape;
+	const int S = shape_support(kind), W = ps->width, R = ps->radius;
+	const double beta = s->spec->formulation.free_surface_penalty_factor * scale;
+	for (idx_t k = 0; k < ps->sample_count; k++) {
+		idx_t node0;
+		double w[SHAPE_NODES_MAX];
+		if (shape_weights_at(g, kind, ps->samples + 2 * k, &node0, w))
+			continue;   /* a surface point beyond the grid's edge: the edge nodes hold it */
+		/* prescribed nodes are 0 at t+1: only the unknowns enter the interpolated p^{t+1} */
+		double p_old = 0.0;
+		for (int a = 0; a < S * S; a++) {
+			const idx_t I = node0 + a % S + (a / S) * g->nodes[0];
+			if (ps->unknown[I] < 0)
+				w[a] = 0.0;
+			p_old += w[a] * f->pressure[I];
+		}
+		/* (beta/2) (w . (p^t + dp))^2: beta w w^T into the matrix, -beta w (w . p^t) into b */
+		for (int a = 0; a < S * S; a++) {
+			if (w[a] == 0.0)
+				continue;
+			const idx_t I = node0 + a % S + (a / S) * g->nodes[0];
+			s->f.rhs[I] -= beta * w[a] * p_old;
+			double *row = ps->stencil + (size_t)I * W * W;
+			for (int b = 0; b < S * S; b++)
+				row[(b % S - a % S + R) + (b / S - a / S + R) * W] += beta * w[a] * w[b];
+		}
+	}
+}
