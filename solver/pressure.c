@@ -44,22 +44,27 @@ enum poro_status pressure_system_init(struct pressure_system *ps, const struct g
 	const size_t gst = (size_t)ps->g_width * ps->g_width * 2;
 	const size_t nnz_max = nodes * (st + 1) / 2;
 	ps->stencil = calloc(nodes * st, sizeof(double));
-	ps->grad_s = calloc(nodes * gst, sizeof(double));
-	ps->grad_w = calloc(nodes * gst, sizeof(double));
-	ps->coupling = calloc(nodes * 6, sizeof(double));
 	ps->unknown = malloc(nodes * sizeof(idx_t));
 	ps->colptr = malloc((nodes + 1) * sizeof(idx_t));
 	ps->rowidx = malloc(nnz_max * sizeof(idx_t));
 	ps->values = malloc(nnz_max * sizeof(double));
 	ps->b = malloc(nodes * sizeof(double));
 	ps->x = malloc(nodes * sizeof(double));
-	ps->diagonal = malloc(nodes * sizeof(double));
-	ps->interior = malloc(nodes);
-	/* at most two surface points on each of a full cell's four faces */
-	ps->sample_max = surface_points ? 8 * (idx_t)g->cell_count : 0;
-	ps->samples = surface_points ? malloc(2 * (size_t)ps->sample_max * sizeof(double)) : NULL;
-	if (!ps->stencil || !ps->grad_s || !ps->grad_w || !ps->coupling || !ps->unknown || !ps->colptr || !ps->rowidx ||
-	    !ps->values || !ps->b || !ps->x || !ps->diagonal || !ps->interior || (surface_points && !ps->samples)) {
+	int ok = ps->stencil && ps->unknown && ps->colptr && ps->rowidx && ps->values && ps->b && ps->x;
+	if (ps->exact) {   /* G_s, G_w, the coupling and the stabilisation's arrays */
+		ps->grad_s = calloc(nodes * gst, sizeof(double));
+		ps->grad_w = calloc(nodes * gst, sizeof(double));
+		ps->coupling = calloc(nodes * 6, sizeof(double));
+		ps->diagonal = malloc(nodes * sizeof(double));
+		ps->interior = malloc(nodes);
+		ok = ok && ps->grad_s && ps->grad_w && ps->coupling && ps->diagonal && ps->interior;
+	}
+	if (surface_points) {   /* at most two surface points on each of a full cell's four faces */
+		ps->sample_max = 8 * (idx_t)g->cell_count;
+		ps->samples = malloc(2 * (size_t)ps->sample_max * sizeof(double));
+		ok = ok && ps->samples;
+	}
+	if (!ok) {
 		pressure_system_release(ps);
 		return poro_error_set(err, PORO_ENOMEM, "cannot allocate the pressure system");
 	}

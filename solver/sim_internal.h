@@ -24,9 +24,11 @@ struct pressure_system {
 	int width;                /* 2 radius + 1 */
 	int g_radius, g_width;    /* reach of the gradient operators G: S - 1, and 2 g_radius + 1 */
 	double *stencil;          /* [node_count * width^2] matrix entries by offset of J from I */
-	double *grad_s, *grad_w;  /* [node_count * g_width^2 * 2] G_s, G_w (Eqs. 67-68) by offset */
+	double *grad_s, *grad_w;  /* [node_count * g_width^2 * 2] G_s, G_w (Eqs. 67-68) by offset;
+				     this and the coupling, diagonal and interior: consistent projection
+				     only (NULL with the Laplacian) */
 	double *coupling;         /* [node_count * 2 * 3] K^-1 (ss, sw, ww) of each node and component,
-				     the correction's phase coupling (consistent projection only) */
+				     the correction's phase coupling */
 	idx_t *unknown;           /* [node_count] unknown number of a node, -1 if not an unknown */
 	idx_t *colptr, *rowidx;   /* CSC upper triangle of the reduced system */
 	double *values, *b, *x;

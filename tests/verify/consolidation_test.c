@@ -199,9 +199,12 @@ static void check_low_permeability(void)
 	printf("INFO k=1e-9 dt=%.1e: %ld steps, pore pressure in [%.4f, %.4f] q\n", ok ? c->time.dt : 0, steps, pmin / q, pmax / q);
 	CHECK(ok && steps == 2000, "low_permeability_runs_2000_steps", "%s", ok ? "" : (s ? sim_error(s)->message : err.message));
 	CHECK(ok && pmin >= -1e-9 * q, "low_permeability_pressure_non_negative", "minimum %.4f q", pmin / q);
-	/* Not met yet: the top cell drains at once while k = 1e-9 m/s allows a boundary layer of
-	 * sqrt(c_v t) ~ 0.5 mm, far below h; the unresolved layer spreads and the pressure below it
-	 * drifts above q (docs/numerics.md). */
+	/* Not met yet: k = 1e-9 m/s allows a drainage layer of sqrt(c_v t) ~ 0.5 mm, far below h.
+	 * With the nodal surface condition the pressure force misses the part of the drop to zero
+	 * that lies outside the points, and the interior rises above q; the interpolated condition
+	 * (consistent projection only, check_low_permeability_interpolated below) keeps the interior
+	 * at q, but within three cells of the surface the pressure still swings above 1.05 q
+	 * (docs/numerics.md, "Free surface"). */
 	CHECK_KNOWN_FAILURE(ok && pmax <= 1.05 * q, "low_permeability_pressure_at_most_1.05q",
 			    "maximum %.4f q after %ld steps", pmax / q, steps);
 	sim_destroy(&s);
