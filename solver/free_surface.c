@@ -194,7 +194,7 @@ void free_surface_mark(struct sim *s)
 void free_surface_add_penalty(struct sim *s, double scale)
 {
 	const struct grid *g = &s->grid;
-	const struct grid_fields *f = &s->f;
+	struct grid_fields *f = &s->f;
 	struct pressure_system *ps = &s->ps;
 	const enum case_shape kind = s->spec->formulation.shape;
 	const int S = shape_support(kind), W = ps->width, R = ps->radius;
@@ -217,7 +217,7 @@ void free_surface_add_penalty(struct sim *s, double scale)
 			if (w[a] == 0.0)
 				continue;
 			const idx_t I = node0 + a % S + (a / S) * g->nodes[0];
-			s->f.rhs[I] -= beta * w[a] * p_old;
+			f->rhs[I] -= beta * w[a] * p_old;
 			double *row = ps->stencil + (size_t)I * W * W;
 			for (int b = 0; b < S * S; b++)
 				row[(b % S - a % S + R) + (b / S - a / S + R) * W] += beta * w[a] * w[b];

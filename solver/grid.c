@@ -54,8 +54,8 @@ enum poro_status grid_fields_init(struct grid_fields *f, const struct grid *g, s
 	GRID_DOUBLE_FIELDS(ALLOC)
 #undef ALLOC
 	if (ok)
-		ok = (f->cell_wet = calloc((size_t)g->cell_count, 1)) && (f->dirichlet = calloc(n, 1)) && (f->surface = calloc(n, 1)) &&
-		     (f->fix_s = calloc(n, 1)) && (f->fix_w = calloc(n, 1));
+		ok = (f->cell_wet = calloc((size_t)g->cell_count, 1)) && (f->dirichlet = calloc(n, 1)) &&
+		     (f->surface = calloc(n, 1)) && (f->fix_s = calloc(n, 1)) && (f->fix_w = calloc(n, 1));
 	if (!ok) {
 		grid_fields_release(f);
 		return poro_error_set(err, PORO_ENOMEM, "cannot allocate a grid of %ld nodes", (long)n);

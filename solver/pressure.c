@@ -389,7 +389,8 @@ enum poro_status pressure_solve(struct sim *s)
 	if (ps->exact) {
 		memset(s->f.rhs, 0, sizeof(double) * (size_t)s->grid.node_count);
 		assemble_exact_projection(s);
-		diagonal_mean = mean_diagonal(s);   /* before any penalty */
+		if (ps->samples)   /* the interpolated free surface's scale, before any penalty */
+			diagonal_mean = mean_diagonal(s);
 		pressure_stabilise(s);   /* pressure_stabilisation.c */
 	} else {
 		for (idx_t q = 0; q < p->n; q++) {

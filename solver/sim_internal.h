@@ -87,7 +87,7 @@ enum poro_status semi_implicit_step(struct sim *s);
 /* semi_implicit.c: lays out the patches of the modified F-bar (000 Eq. 83) once, at create. */
 void stabilisation_patches_init(struct sim *s);
 
-/* pressure.c: free-surface detection and the Poisson solve (000 §4.5 step 5). */
+/* pressure.c: the Poisson solve (000 §4.5 step 5). */
 /* surface_points: room for the interpolated free-surface condition's points (free_surface.c). */
 enum poro_status pressure_system_init(struct pressure_system *ps, const struct grid *g, int support,
 				      enum pressure_projection projection, int surface_points, struct poro_error *err);
