@@ -2,29 +2,69 @@
  * loads.c - external loads: tractions on body faces (the surface integral of 000 Eq. 54) and
  * gravity with its ramp.
  *
- * A traction acts on the soil points of the loaded face: the outermost row of points of the body
- * on that face of its bounding box, within [from, to] along it. Each such point carries its share
- * of the face, N dA = outward normal times the point spacing h / particles_per_cell, in the
- * reference configuration; the current share follows Nanson's formula da = J F^-T N dA, so a load
- * keeps acting on the material face as it deforms. The traction vector is a dead load (fixed
- * direction) scaled by its time function. It is applied at the face midpoint (see below).
+ * A traction acts on the loaded face of a body: the outermost row of points of the body on that
+ * face of its bounding box, within [from, to] along it. The traction vector t is a dead load
+ * (fixed direction) scaled by its time function. Its nodal forces f_I = int_face S_I t da are
+ * integrated in one of two ways.
+ *
+ * Through the body's points (every body at least LOAD_DEPTH_SUPPORTS shape-function supports
+ * thick along the face's normal N). With a weight phi that is 1 on the loaded face and falls
+ * linearly with the reference depth d to 0 on the far side (phi = 1 - d / D, D the body's
+ * thickness), the divergence theorem over the strip of the body under the loaded points (the
+ * points whose reference coordinate along the face lies within the loaded points' extent) gives
+ *     int_face S_I t (N . n) da = int_strip div(S_I phi t (x) N) dV
+ *                               ~ t sum_p V_p (phi_p N . grad S_I(x_p) + S_I(x_p) N . grad phi_p).
+ * The point sum is the quadrature the internal force uses (f_int = -sum_p V_p sigma_p grad S_I),
+ * so near the face, where phi ~ 1, a stress equal to the traction (sigma N = t) nearly balances
+ * the load wherever the face lies in its cell, and the total load is exact: sum_I of the forces
+ * is t sum_p V_p N . grad phi = t sum_p V0_p (N . cof F N) / D, the face's projected area for
+ * any deformation uniform along the strip. Evaluating the load at the faces instead balances it
+ * only when the face lies on a grid line or a cell's middle (there the points' midpoint rule
+ * integrates the B-splines' piecewise-linear gradients exactly); elsewhere the nodes just beyond
+ * the surface, which carry a few per cent of a full node's mass, take a load that their share of
+ * the stress divergence does not match, and they strain the top row until it does: the Xie-Leo
+ * column's top row was compressed 2.4% beyond its final strain and the column settled 4.0%
+ * (double point) and 1.1% (single point) ahead of Eq. 87 at U = 0.25 (docs/numerics.md,
+ * "Tractions"; tests/solver/loads_test.c measures the mismatch both ways). Summing only over
+ * the nodes next to the face (phi = 1 there, 0 beyond) balances those nodes exactly but leaves
+ * the total to the midpoint rule where the weight drops: 3.5% short to 2.5% over in the Xie-Leo
+ * column as it compresses, which its final settlement followed. The load is per area projected
+ * on the face's reference plane ((N . n) da), the current area while the face keeps its
+ * orientation.
+ *
+ * At the point faces (thinner bodies: there phi would fall to 0 within a few cells, and the
+ * smeared part S_I N . grad phi would outweigh the part that balances the stress). Each loaded
+ * point carries its share of the face, N dA = outward normal times the point spacing
+ * h / particles_per_cell, in the reference configuration; the current share follows Nanson's
+ * formula da = J F^-T N dA, so the load keeps acting on the material face as it deforms. It is
+ * applied at the face midpoint, centre + F N d / 2: mapping it at the centre gives the nodes
+ * beyond the surface a quarter of the load their share of the stress divergence asks for, and
+ * the surplus accelerates those low-mass nodes without bound.
  */
 #include <math.h>
 
 #include "shape.h"
 #include "sim_internal.h"
 
+/* A body takes the integration through its points when it is at least this many shape-function
+ * supports thick along the loaded face's normal, so that phi stays within 1/4 of 1 over the
+ * support of the nodes next to the face (quadratic B-splines: 6 cells). */
+#define LOAD_DEPTH_SUPPORTS 2
+
 void loads_init(struct sim *s)
 {
 	const struct case_spec *c = s->spec;
 	struct particles *p = &s->soil;
+	const double h = c->grid.cell_size;
 	for (int l = 0; l < c->load_count; l++) {
 		const struct case_load *load = &c->loads[l];
 		const struct case_body *body = &c->bodies[load->body];
-		const double spacing = c->grid.cell_size / body->particles_per_cell;
+		const double spacing = h / body->particles_per_cell;
 		const int axis = (load->face == FACE_LEFT || load->face == FACE_RIGHT) ? 0 : 1;
 		const int upper = load->face == FACE_RIGHT || load->face == FACE_TOP;
 		const double face = upper ? body->max[axis] : body->min[axis];
+		struct load_band *band = &s->load_bands[l];
+		band->along[0] = INFINITY, band->along[1] = -INFINITY;
 		for (idx_t q = 0; q < p->n; q++) {
 			if (p->body[q] != load->body)
 				continue;
@@ -34,28 +74,28 @@ void loads_init(struct sim *s)
 			p->surface_load[q] = l;
 			p->surface[2 * q + axis] = (upper ? 1.0 : -1.0) * spacing;
 			p->surface[2 * q + 1 - axis] = 0.0;
+			/* the strip under a loaded point is its column of points, spacing wide */
+			band->along[0] = fmin(band->along[0], along - 0.5 * spacing);
+			band->along[1] = fmax(band->along[1], along + 0.5 * spacing);
 		}
+		const double depth = body->max[axis] - body->min[axis];
+		band->through_points = depth >= LOAD_DEPTH_SUPPORTS * shape_support(c->formulation.shape) * h;
 	}
 }
 
-/* The traction of a loaded point acts on its face, not at its centre: the face midpoint is the
- * centre plus F (N / |N|) d / 2 (d the point spacing). Mapping the load at the centre instead
- * gives the nodes beyond the surface a quarter of the load their share of the stress divergence
- * asks for, and the surplus accelerates those low-mass nodes without bound. */
-void loads_add_tractions(struct sim *s, double time, double *force)
+/* Load l at the midpoints of its points' faces (file comment). */
+static void add_at_faces(struct sim *s, int l, double scale, double *force)
 {
 	const struct case_spec *c = s->spec;
 	const struct particles *p = &s->soil;
 	const int S = p->support, nn = S * S;
+	const double tx = c->loads[l].traction[0] * scale, ty = c->loads[l].traction[1] * scale;
 	for (idx_t q = 0; q < p->n; q++) {
-		int l = p->surface_load[q];
-		if (l < 0)
+		if (p->surface_load[q] != l)
 			continue;
 		const double *F = p->F + 4 * q, *N = p->surface + 2 * q;
 		/* J F^-T N in 2-D: [[F11, -F10], [-F01, F00]] N */
-		double ax = F[3] * N[0] - F[2] * N[1], ay = -F[1] * N[0] + F[0] * N[1];
-		double area = hypot(ax, ay) * case_time_function_value(&c->loads[l].time_function, time);
-		double tx = c->loads[l].traction[0] * area, ty = c->loads[l].traction[1] * area;
+		double area = hypot(F[3] * N[0] - F[2] * N[1], -F[1] * N[0] + F[0] * N[1]);
 		/* N has length d, so F N / 2 reaches from the centre to the face */
 		double face[2] = {p->x[2 * q] + 0.5 * (F[0] * N[0] + F[1] * N[1]),
 				  p->x[2 * q + 1] + 0.5 * (F[2] * N[0] + F[3] * N[1])};
@@ -65,9 +105,59 @@ void loads_add_tractions(struct sim *s, double time, double *force)
 			continue;   /* the face left the grid: the point itself is reported by step 1 */
 		for (int k = 0; k < nn; k++) {
 			idx_t I = node0 + k % S + (k / S) * s->grid.nodes[0];
-			force[2 * I] += w[k] * tx;
-			force[2 * I + 1] += w[k] * ty;
+			force[2 * I] += w[k] * tx * area;
+			force[2 * I + 1] += w[k] * ty * area;
 		}
+	}
+}
+
+/* Load l through the points of the strip under it (file comment):
+ *     f_I = t sum_p V_p (phi_p N . grad S_I(x_p) + S_I(x_p) N . grad phi_p),
+ * phi = 1 - d / D falling from the loaded face (reference depth d = 0) to the far side (d = D). */
+static void add_through_points(struct sim *s, int l, double scale, double *force)
+{
+	const struct case_spec *c = s->spec;
+	const struct case_load *load = &c->loads[l];
+	const struct case_body *body = &c->bodies[load->body];
+	const struct load_band *band = &s->load_bands[l];
+	const struct particles *p = &s->soil;
+	const int S = p->support, nn = S * S;
+	const idx_t nx = s->grid.nodes[0];
+	const int axis = (load->face == FACE_LEFT || load->face == FACE_RIGHT) ? 0 : 1;
+	const int upper = load->face == FACE_RIGHT || load->face == FACE_TOP;
+	const double sign = upper ? 1.0 : -1.0, face = upper ? body->max[axis] : body->min[axis];
+	const double D = body->max[axis] - body->min[axis];
+	const double tx = load->traction[0] * scale, ty = load->traction[1] * scale;
+	for (idx_t q = 0; q < p->n; q++) {
+		const double along = p->x0[2 * q + 1 - axis];
+		if (p->body[q] != load->body || along < band->along[0] || along > band->along[1])
+			continue;
+		const double phi = 1.0 - sign * (face - p->x0[2 * q + axis]) / D;
+		if (!(phi > 0.0))
+			continue;
+		/* N . grad phi = N . F^-T N / D in the current configuration: F_xx / J for a face
+		 * normal to y, F_yy / J for one normal to x */
+		const double *F = p->F + 4 * q;
+		const double N_grad_phi = (axis == 1 ? F[0] : F[3]) / ((F[0] * F[3] - F[1] * F[2]) * D);
+		const double *w = p->w + (size_t)q * nn, *dw = p->dw + (size_t)q * 2 * nn;
+		for (int k = 0; k < nn; k++) {
+			const idx_t I = p->node0[q] + k % S + (k / S) * nx;
+			const double g = p->volume[q] * (phi * sign * dw[2 * k + axis] + w[k] * N_grad_phi);
+			force[2 * I] += tx * g;
+			force[2 * I + 1] += ty * g;
+		}
+	}
+}
+
+void loads_add_tractions(struct sim *s, double time, double *force)
+{
+	const struct case_spec *c = s->spec;
+	for (int l = 0; l < c->load_count; l++) {
+		const double scale = case_time_function_value(&c->loads[l].time_function, time);
+		if (s->load_bands[l].through_points)
+			add_through_points(s, l, scale, force);
+		else
+			add_at_faces(s, l, scale, force);
 	}
 }
 

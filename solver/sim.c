@@ -142,8 +142,10 @@ static enum poro_status allocate_scratch(struct sim *s)
 	s->patch_mass = calloc((size_t)s->grid.cell_count, sizeof(double));
 	s->patch_mass_Je = calloc((size_t)s->grid.cell_count, sizeof(double));
 	s->probe_point = calloc((size_t)s->spec->probe_count + 1, sizeof(int));
+	s->load_bands = calloc((size_t)s->spec->load_count + 1, sizeof *s->load_bands);
 	if (!s->soil_grad || !s->soil_scalar || !s->soil_coef || !s->water_vec || !s->water_scalar ||
-	    !s->water_coef || !s->cell_fill || !s->cell_fill_soil || !s->patch_mass || !s->patch_mass_Je || !s->probe_point)
+	    !s->water_coef || !s->cell_fill || !s->cell_fill_soil || !s->patch_mass || !s->patch_mass_Je ||
+	    !s->probe_point || !s->load_bands)
 		return poro_error_set(&s->err, PORO_ENOMEM, "cannot allocate step workspaces");
 	return PORO_OK;
 }
@@ -222,6 +224,7 @@ void sim_destroy(struct sim **ps)
 	free(s->patch_mass);
 	free(s->patch_mass_Je);
 	free(s->probe_point);
+	free(s->load_bands);
 	free(s);
 	*ps = NULL;
 }

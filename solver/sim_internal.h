@@ -62,6 +62,7 @@ struct sim {
 	double *water_coef;           /* [n_water] */
 	double *cell_fill;            /* [cell_count] volume of pressure-carrying points per cell, m^3/m */
 	double *cell_fill_soil;       /* [cell_count] volume of soil points per cell (double point), m^3/m */
+	struct load_band *load_bands; /* [load_count] how each traction is integrated (loads.c) */
 
 	/* Patches of the modified F-bar (000 Eq. 83): a fixed tiling of the grid into
 	 * patches[0] x patches[1] rectangles of patch_width (about h_patch; see semi_implicit.c) */
@@ -112,6 +113,10 @@ void boundary_mark(struct sim *s);
 void boundary_apply(const struct grid *g, const unsigned char *fix, double *v);
 
 /* loads.c: tractions on body faces (000 Eq. 54) and gravity with its ramp. */
+struct load_band {
+	int through_points;           /* 1: integrated through the body's points; 0: at the point faces */
+	double along[2];              /* reference extent along the face of the loaded points' strips, m */
+};
 void loads_init(struct sim *s);
 void loads_add_tractions(struct sim *s, double time, double *force);
 void loads_gravity(const struct case_spec *c, double time, double b[2]);

@@ -9,7 +9,14 @@
  *    stress is E ln(l) / l for stretch l, so the column settles to H (1 - l) with
  *    E ln(l) / l = -q), and the difference to the small-strain run reported next to the
  *    paper's "about 17%";
- *  - soil and water mass conserved to 1e-12 at every step.
+ *  - soil and water mass conserved to 1e-12 at every step;
+ *  - at the end, the settlement the soil points' volumes account for is within 2% of the top's
+ *    (VOLUME_GAP_MAX): in double point with pure FLIP they drifted 7.5% apart (13.7 mm, all
+ *    within Tv < 0.1: the points' volume follows the MUSL remap of their velocities, their
+ *    position the grid velocity, and the FLIP noise of the first steps sets the two apart), the
+ *    column's porosity and stress then ran ahead of its motion and it settled 5.7% short at
+ *    Tv = 2. The double-point cases blend 1% PIC into the velocity update (flip_fraction 0.99):
+ *    0.8% apart. Single point, pure FLIP: 0.2% (docs/numerics.md, "Tractions").
  * The double-point cases (xie_leo.json, xie_leo_hencky.json) run with the second-difference
  * pressure stabilisation (docs/numerics.md): without it the node-to-node pressure pattern
  * stalled the column from U = 0.5 on (20% short at the end, Hencky 39% short).
@@ -32,6 +39,7 @@
 
 #define CASES "tests/cases/"
 #define G 9.81
+#define VOLUME_GAP_MAX 0.02
 
 struct column {
 	double H, q, k, rho_w, mv, E, spacing;
@@ -94,8 +102,21 @@ static double pressure_rms(const struct sim *s, const struct column *col, double
 
 struct run {
 	double settle[4], analytic[4], rms[3], drift, soil_drift;
+	double volume_settle;   /* m, at the end: sum_p (V0_p - V_p) over the column's width */
 	int ok;
 };
+
+/* Settlement the soil points' volumes account for: in one dimension the column loses exactly the
+ * volume its top moves down by, so this equals settlement() unless the volumes (which set the
+ * porosity, the conductivity and the stress) drift from the motion of the points. */
+static double volume_settlement(const struct sim *s, const struct case_spec *c)
+{
+	const struct particles *p = sim_soil(s);
+	double lost = 0;
+	for (idx_t q = 0; q < p->n; q++)
+		lost += p->volume0[q] - p->volume[q];
+	return lost / (c->bodies[0].max[0] - c->bodies[0].min[0]);
+}
 
 static struct run run_case(const char *file)
 {
@@ -133,6 +154,7 @@ static struct run run_case(const char *file)
 		if (i < 3)
 			r.rms[i] = pressure_rms(s, &col, Tv[i], col.H - r.settle[i]);
 	}
+	r.volume_settle = volume_settlement(s, c);
 	sim_destroy(&s);
 	case_destroy(&c);
 	return r;
@@ -174,6 +196,11 @@ static void check_variant(const struct expectation *e, struct run *out)
 		else
 			CHECK(r.ok && r.rms[i] <= 0.05, name, "rms/q %.4f", r.rms[i]);
 	}
+	double gap = fabs(r.volume_settle - r.settle[3]) / r.settle[3];
+	printf("INFO xie-leo %s end: settlement from the soil points' volumes %.5f m, from the top %.5f m "
+	       "(%.2f%% apart)\n", e->label, r.volume_settle, r.settle[3], 100 * gap);
+	snprintf(name, sizeof name, "xie_leo_%s_volumes_follow_the_settlement", e->label);
+	CHECK(r.ok && gap <= VOLUME_GAP_MAX, name, "%.2f%% apart", 100 * gap);
 	double drift = e->water_mass_conserved ? r.drift : r.soil_drift;
 	printf("INFO xie-leo %s: max relative mass drift %.3e (%s)\n", e->label, drift,
 	       e->water_mass_conserved ? "soil and water" : "soil; single-point water drains out");
@@ -185,7 +212,7 @@ static void check_variant(const struct expectation *e, struct run *out)
 int main(void)
 {
 	const struct expectation variants[2] = {
-		{"double_point", CASES "xie_leo.json", 1, 0, {1, 0, 0, 0}, {0, 0, 0}},
+		{"double_point", CASES "xie_leo.json", 1, 0, {0, 0, 0, 0}, {0, 0, 0}},
 		{"single_point", CASES "xie_leo_single_point.json", 0, 0, {0, 0, 0, 0}, {0, 0, 0}},
 	};
 	struct run small[2];
