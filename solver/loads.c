@@ -30,7 +30,9 @@
  * the total to the midpoint rule where the weight drops: 3.5% short to 2.5% over in the Xie-Leo
  * column as it compresses, which its final settlement followed. The load is per area projected
  * on the face's reference plane ((N . n) da), the current area while the face keeps its
- * orientation.
+ * orientation. D is the thickness of the body's bounding box: a polygon whose far side under the
+ * loaded span lies inside the box (an overhang) would take the part of the load that phi leaves
+ * there on that side, so such spans want the box's full depth of material under them.
  *
  * At the point faces (thinner bodies: there phi would fall to 0 within a few cells, and the
  * smeared part S_I N . grad phi would outweigh the part that balances the stress). Each loaded
