@@ -49,8 +49,8 @@
 #include "sim_internal.h"
 
 /* A body takes the integration through its points when it is at least this many shape-function
- * supports thick along the loaded face's normal, so that phi stays within 1/4 of 1 over the
- * support of the nodes next to the face (quadratic B-splines: 6 cells). */
+ * supports thick along the loaded face's normal (quadratic B-splines: 6 cells), so that phi stays
+ * above about one half over the supports of the nodes next to the face. */
 #define LOAD_DEPTH_SUPPORTS 2
 
 void loads_init(struct sim *s)
