@@ -25,6 +25,10 @@ enum case_shape { SHAPE_LINEAR, SHAPE_QUADRATIC_BSPLINE, SHAPE_CUBIC_BSPLINE };
 enum pressure_projection { PROJECTION_LAPLACIAN, PROJECTION_CONSISTENT };
 enum pressure_stabilisation { PRESSURE_STABILISATION_NONE, PRESSURE_STABILISATION_SECOND_DIFFERENCE };
 enum free_surface_condition { FREE_SURFACE_NODES, FREE_SURFACE_INTERPOLATED };
+/* What moves the soil points (step 7b): the grid velocity v^{t+1}, or the MUSL displacement of
+ * step 8a, the field whose gradient also updates F and the volume (docs/numerics.md, "Volumes
+ * that follow the motion"). */
+enum position_update { POSITION_UPDATE_GRID_VELOCITY, POSITION_UPDATE_MUSL_DISPLACEMENT };
 /* Soil-phase stabilisation (000 §4.4.2, docs/numerics.md): none; F-bar with the node-wise averaged
  * volume change (Eqs. 79-80); modified F-bar (Eq. 81), which also scales Be^t to the patch-wise
  * averaged elastic Jacobian (Eqs. 82-83; patch 1.5 h for B-splines, the cell for linear); and the
@@ -82,6 +86,7 @@ struct case_formulation {
 	enum free_surface_condition free_surface; /* "nodes" (default) or "interpolated" (free_surface.c;
 						     consistent projection only) */
 	double free_surface_penalty_factor;   /* > 0, weight of the interpolated condition; default 1e4 */
+	enum position_update position_update; /* soil points: "grid_velocity" (default) or "musl_displacement" */
 };
 
 struct case_grid {

@@ -25,7 +25,12 @@
  *  - the drag of Eq. 58 is scaled by the node's soil share, so free water standing above the
  *    soil is not dragged as if it filled pores (see soil_fraction);
  *  - in the Laplacian L (Eq. 61) the porosity stays inside the point sum so that L is symmetric
- *    (see pressure.c).
+ *    (see pressure.c);
+ *  - formulation.position_update "musl_displacement" moves the soil points by the MUSL
+ *    displacement of step 8a instead of the grid velocity of step 7b: the volume and F follow
+ *    the gradient of that displacement, and with FLIP noise in the point velocities (which the
+ *    MUSL remap carries and v^{t+1} does not) the two drift apart otherwise: 7.2% of the
+ *    double-point Xie-Leo column's settlement (docs/numerics.md, "Volumes that follow the motion").
  * Single point: the water set rides on the soil points (same positions, volumes, porosity), so
  * every formula below serves both variants; only the water points' own motion differs.
  */
@@ -300,7 +305,8 @@ static void attach_water_to_soil(struct sim *s)
 static void update_points(struct sim *s)
 {
 	struct grid_fields *f = &s->f;
-	move_points(s, &s->soil, f->v_s, f->v_s_old, s->soil_grad, 1);
+	move_points(s, &s->soil, f->v_s, f->v_s_old, s->soil_grad,
+		    s->spec->formulation.position_update == POSITION_UPDATE_GRID_VELOCITY);
 	if (s->spec->gravity.water_attached && in_gravity_ramp(s))
 		attach_water_to_soil(s);
 	else
@@ -482,6 +488,12 @@ static enum poro_status update_soil_kinematics(struct sim *s)
 			f->du_s[2 * I + c] = f->mass_s[I] > 0.0 ? s->dt * f->du_s[2 * I + c] / f->mass_s[I] : 0.0;
 	boundary_apply(&s->grid, f->fix_s, f->du_s);
 	g2p_vector_gradient(&s->grid, p, f->du_s, p->dF);
+	if (s->spec->formulation.position_update == POSITION_UPDATE_MUSL_DISPLACEMENT) {
+		/* 7b from the field whose gradient is dF, so volume and motion stay one (file comment) */
+		g2p_vector(&s->grid, p, f->du_s, s->soil_grad);
+		for (idx_t k = 0; k < 2 * p->n; k++)
+			p->x[k] += s->soil_grad[k];
+	}
 	for (idx_t q = 0; q < p->n; q++) {
 		p->dF[4 * q] += 1.0, p->dF[4 * q + 3] += 1.0;
 	}

@@ -184,6 +184,8 @@ static void test_minimal_defaults(const struct case_spec *c)
 	      f->pressure_stabilisation_factor);
 	CHECK(f->free_surface == FREE_SURFACE_NODES && f->free_surface_penalty_factor == 1e4, "default free surface",
 	      "kind %d factor %g", f->free_surface, f->free_surface_penalty_factor);
+	CHECK(f->position_update == POSITION_UPDATE_GRID_VELOCITY, "default position update", "got %d",
+	      f->position_update);
 	CHECK(c->bodies[0].permeability_law == PERMEABILITY_CONSTANT, "default permeability law", "got %d",
 	      c->bodies[0].permeability_law);
 	CHECK(c->fluid.density == 1000 && c->fluid.bulk_modulus == 2.2e9, "default fluid",
@@ -378,6 +380,20 @@ static void test_out_of_range(void)
 		CHECK(c && c->formulation.free_surface == FREE_SURFACE_INTERPOLATED &&
 		      c->formulation.free_surface_penalty_factor == 385.2, "free surface read", "kind %d factor %g",
 		      c ? (int)c->formulation.free_surface : -1, c ? c->formulation.free_surface_penalty_factor : 0.0);
+		case_destroy(&c);
+		free(text);
+	}
+	expect_invalid("unknown position update", "/formulation/position_update", "\"particle_velocity\"",
+		       "/formulation/position_update: must be one of 'grid_velocity', 'musl_displacement', "
+		       "got 'particle_velocity'");
+	expect_invalid("position update not a string", "/formulation/position_update", "2",
+		       "/formulation/position_update: expected a string, got number");
+	{
+		const struct edit e[] = { { "/formulation/position_update", "\"musl_displacement\"" } };
+		char *text = edited(full_case, e, 1);
+		struct case_spec *c = load_valid("position update by the MUSL displacement", text);
+		CHECK(c && c->formulation.position_update == POSITION_UPDATE_MUSL_DISPLACEMENT, "position update read",
+		      "got %d", c ? (int)c->formulation.position_update : -1);
 		case_destroy(&c);
 		free(text);
 	}

@@ -11,12 +11,12 @@
  *    paper's "about 17%";
  *  - soil and water mass conserved to 1e-12 at every step;
  *  - at the end, the settlement the soil points' volumes account for is within 2% of the top's
- *    (VOLUME_GAP_MAX): in double point with pure FLIP they drifted 7.5% apart (13.7 mm, all
- *    within Tv < 0.1: the points' volume follows the MUSL remap of their velocities, their
- *    position the grid velocity, and the FLIP noise of the first steps sets the two apart), the
- *    column's porosity and stress then ran ahead of its motion and it settled 5.7% short at
- *    Tv = 2. The double-point cases blend 1% PIC into the velocity update (flip_fraction 0.99):
- *    0.8% apart. Single point, pure FLIP: 0.2% (docs/numerics.md, "Tractions").
+ *    (VOLUME_GAP_MAX). The cases move the soil points by the MUSL displacement whose gradient
+ *    updates their volume (formulation.position_update "musl_displacement"): 0.22% apart in
+ *    double point. With the grid-velocity update the FLIP noise of the first steps set the two
+ *    7.2% apart (the volume follows the remapped point velocities, the position the grid
+ *    velocity), the porosity and stress ran ahead of the motion and the column settled 5.7%
+ *    short at Tv = 2 (docs/numerics.md, "Volumes that follow the motion").
  * The double-point cases (xie_leo.json, xie_leo_hencky.json) run with the second-difference
  * pressure stabilisation (docs/numerics.md): without it the node-to-node pressure pattern
  * stalled the column from U = 0.5 on (20% short at the end, Hencky 39% short).
