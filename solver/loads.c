@@ -62,26 +62,27 @@ void loads_init(struct sim *s)
 		const struct case_load *load = &c->loads[l];
 		const struct case_body *body = &c->bodies[load->body];
 		const double spacing = h / body->particles_per_cell;
-		const int axis = (load->face == FACE_LEFT || load->face == FACE_RIGHT) ? 0 : 1;
-		const int upper = load->face == FACE_RIGHT || load->face == FACE_TOP;
-		const double face = upper ? body->max[axis] : body->min[axis];
 		struct load_band *band = &s->load_bands[l];
+		const int axis = band->axis = (load->face == FACE_LEFT || load->face == FACE_RIGHT) ? 0 : 1;
+		const int upper = load->face == FACE_RIGHT || load->face == FACE_TOP;
+		band->sign = upper ? 1.0 : -1.0;
+		band->face = upper ? body->max[axis] : body->min[axis];
+		band->depth = body->max[axis] - body->min[axis];
+		band->through_points = band->depth >= LOAD_DEPTH_SUPPORTS * shape_support(c->formulation.shape) * h;
 		band->along[0] = INFINITY, band->along[1] = -INFINITY;
 		for (idx_t q = 0; q < p->n; q++) {
 			if (p->body[q] != load->body)
 				continue;
 			double normal_coord = p->x0[2 * q + axis], along = p->x0[2 * q + 1 - axis];
-			if (fabs(normal_coord - face) >= spacing || along < load->from || along > load->to)
+			if (fabs(normal_coord - band->face) >= spacing || along < load->from || along > load->to)
 				continue;
 			p->surface_load[q] = l;
-			p->surface[2 * q + axis] = (upper ? 1.0 : -1.0) * spacing;
+			p->surface[2 * q + axis] = band->sign * spacing;
 			p->surface[2 * q + 1 - axis] = 0.0;
 			/* the strip under a loaded point is its column of points, spacing wide */
 			band->along[0] = fmin(band->along[0], along - 0.5 * spacing);
 			band->along[1] = fmax(band->along[1], along + 0.5 * spacing);
 		}
-		const double depth = body->max[axis] - body->min[axis];
-		band->through_points = depth >= LOAD_DEPTH_SUPPORTS * shape_support(c->formulation.shape) * h;
 	}
 }
 
@@ -118,17 +119,12 @@ static void add_at_faces(struct sim *s, int l, double scale, double *force)
  * phi = 1 - d / D falling from the loaded face (reference depth d = 0) to the far side (d = D). */
 static void add_through_points(struct sim *s, int l, double scale, double *force)
 {
-	const struct case_spec *c = s->spec;
-	const struct case_load *load = &c->loads[l];
-	const struct case_body *body = &c->bodies[load->body];
+	const struct case_load *load = &s->spec->loads[l];
 	const struct load_band *band = &s->load_bands[l];
 	const struct particles *p = &s->soil;
-	const int S = p->support, nn = S * S;
+	const int S = p->support, nn = S * S, axis = band->axis;
 	const idx_t nx = s->grid.nodes[0];
-	const int axis = (load->face == FACE_LEFT || load->face == FACE_RIGHT) ? 0 : 1;
-	const int upper = load->face == FACE_RIGHT || load->face == FACE_TOP;
-	const double sign = upper ? 1.0 : -1.0, face = upper ? body->max[axis] : body->min[axis];
-	const double D = body->max[axis] - body->min[axis];
+	const double sign = band->sign, face = band->face, D = band->depth;
 	const double tx = load->traction[0] * scale, ty = load->traction[1] * scale;
 	for (idx_t q = 0; q < p->n; q++) {
 		const double along = p->x0[2 * q + 1 - axis];

@@ -115,6 +115,10 @@ void boundary_apply(const struct grid *g, const unsigned char *fix, double *v);
 /* loads.c: tractions on body faces (000 Eq. 54) and gravity with its ramp. */
 struct load_band {
 	int through_points;           /* 1: integrated through the body's points; 0: at the point faces */
+	int axis;                     /* the face's normal: 0 = x (left, right), 1 = y (bottom, top) */
+	double sign;                  /* +1 for an upper face (right, top), -1 for a lower one */
+	double face, depth;           /* reference coordinate of the face along axis, and the body's
+				         bounding-box thickness along it, m */
 	double along[2];              /* reference extent along the face of the loaded points' strips, m */
 };
 void loads_init(struct sim *s);
