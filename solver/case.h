@@ -24,7 +24,7 @@ enum case_shape { SHAPE_LINEAR, SHAPE_QUADRATIC_BSPLINE, SHAPE_CUBIC_BSPLINE };
  * consistent with the velocity correction (docs/numerics.md compares them). */
 enum pressure_projection { PROJECTION_LAPLACIAN, PROJECTION_CONSISTENT };
 enum pressure_stabilisation { PRESSURE_STABILISATION_NONE, PRESSURE_STABILISATION_SECOND_DIFFERENCE };
-enum free_surface_condition { FREE_SURFACE_NODES, FREE_SURFACE_INTERPOLATED };
+enum free_surface_condition { FREE_SURFACE_NODES, FREE_SURFACE_INTERPOLATED, FREE_SURFACE_WEAK };
 /* What moves the soil points (step 7b): the grid velocity v^{t+1}, or the MUSL displacement of
  * step 8a, the field whose gradient also updates F and the volume (docs/numerics.md, "Volumes
  * that follow the motion"). */
@@ -83,8 +83,8 @@ struct case_formulation {
 	enum pressure_stabilisation pressure_stabilisation; /* "none" (default) or "second_difference"
 							       (pressure_stabilisation.c; consistent projection only) */
 	double pressure_stabilisation_factor; /* > 0, weight of the second-difference penalty; default 10 */
-	enum free_surface_condition free_surface; /* "nodes" (default) or "interpolated" (free_surface.c;
-						     consistent projection only) */
+	enum free_surface_condition free_surface; /* "nodes" (default), "interpolated" or "weak"
+						     (free_surface.c; the last two: consistent projection only) */
 	double free_surface_penalty_factor;   /* > 0, weight of the interpolated condition; default 1e4 */
 	enum position_update position_update; /* soil points: "grid_velocity" (default) or "musl_displacement" */
 };

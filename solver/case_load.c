@@ -60,7 +60,7 @@ static const char *const phases_names[] = { "double_point", "single_point", NULL
 static const char *const shape_names[] = { "linear", "quadratic_bspline", "cubic_bspline", NULL };
 static const char *const projection_names[] = { "laplacian", "consistent", NULL };
 static const char *const pressure_stabilisation_names[] = { "none", "second_difference", NULL };
-static const char *const free_surface_names[] = { "nodes", "interpolated", NULL };
+static const char *const free_surface_names[] = { "nodes", "interpolated", "weak", NULL };
 static const char *const position_update_names[] = { "grid_velocity", "musl_displacement", NULL };
 static const char *const stabilisation_names[] = { "none", "fbar", "modified_fbar", "modified_fbar_cellwise",
 							   NULL };

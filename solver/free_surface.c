@@ -39,6 +39,23 @@
  *    f h beyond the face, a cell filled to f_wet < 1 next to an empty one (1 - f_wet) h inside;
  *    in general (f_wet + f_dry - 1) h, kept within half a cell. Drained grid faces keep their
  *    nodes at 0 and get no surface points (the B-splines interpolate at the grid edge).
+ *  - "weak" (consistent projection only): the pressure is zero beyond the surface, not on it, and
+ *    the material's pressure need not drop inside it. The gradient operator of the projection,
+ *    G_IJ = sum_p V_p S_Ip grad S_Jp, is the pressure force integrated by parts with the
+ *    pressure's push on the surface left out; the condition puts that push back,
+ *        G_IJ -= sum_x a_x n_x S_I(x) S_J(x)
+ *    over the same surface points (a_x n_x: the point's share of its face, outward), so that G p
+ *    is the divergence form -int p grad S_I with p = 0 outside. A pressure that stays at q up to
+ *    the surface then carries a load q on it, as the undrained column needs, where the nodal and
+ *    interpolated conditions need a drop within a cell that the points sample only in part (the
+ *    overshoot of docs/numerics.md). G^T becomes the divergence without the surface flux, so
+ *    water leaves through the surface as the drag lets it. The push acts on a phase's nodes only
+ *    where its nodal mass is not negligible (BOUNDARY_MASS_FLOOR), and the force stays a
+ *    point-quadrature sum elsewhere, so nearly empty nodes stay bounded as in the gradient form,
+ *    unlike the divergence form over the points (docs/numerics.md). Every node that points of
+ *    full cells can reach is an unknown, including ghost nodes beyond the surface; the second
+ *    difference penalty on the grid lines through them (pressure_stabilisation.c) extends the
+ *    field inside smoothly to them (Burman's ghost penalty for cut cells); farther nodes are 0.
  */
 #include <assert.h>
 #include <math.h>
@@ -49,6 +66,10 @@
 
 /* A cell is full (below the free surface) when its points' volumes reach this fraction of it. */
 #define FREE_SURFACE_FILL 0.5
+/* The weak condition's boundary term acts on a node's phase only where that phase's nodal mass
+ * reaches this fraction of the largest: a surface point may lie beyond the points' reach, and its
+ * push on a node they barely touch would be divided by a mass near zero. */
+#define BOUNDARY_MASS_FLOOR 1e-3
 
 /* fill[c] = the summed volumes of the points of p in cell c (points outside the grid left out). */
 static void cell_volumes(const struct grid *g, const struct particles *p, double *fill)
@@ -132,11 +153,15 @@ static void add_surface_face(struct sim *s, idx_t ci, idx_t cj, int dx, int dy)
 	const double gauss = g->h / (2.0 * sqrt(3.0));   /* two-point Gauss rule along the face */
 	for (int e = 0; e < 2; e++) {
 		assert(ps->sample_count < ps->sample_max);
-		double *x = ps->samples + 2 * ps->sample_count++;
+		double *x = ps->samples + 2 * ps->sample_count, *nw = ps->sample_normal + 2 * ps->sample_count;
+		ps->sample_count++;
 		const double t = e ? gauss : -gauss;
 		x[0] = cx + (dx == 0 ? t : 0.0);
 		x[1] = cy + (dy == 0 ? t : 0.0);
+		nw[0] = 0.5 * g->h * dx, nw[1] = 0.5 * g->h * dy;
 	}
+	if (s->spec->formulation.free_surface == FREE_SURFACE_WEAK)
+		return;
 	for (int e = 0; e < 2; e++) {
 		const idx_t i = ci + (dx ? dx > 0 : e), j = cj + (dy ? dy > 0 : e);
 		const idx_t I = grid_node(g, i, j);
@@ -168,6 +193,37 @@ static void place_surface(struct sim *s, const int open[FACE_COUNT])
 		}
 }
 
+/* Node (i, j) under the nodal and interpolated conditions: prescribed when a cell next to it is
+ * dry. */
+static int node_dry(const struct sim *s, const int open[FACE_COUNT], idx_t i, idx_t j)
+{
+	int dry = on_drained_face(s, i, j);
+	for (idx_t cj = j - 1; cj <= j; cj++)
+		for (idx_t ci = i - 1; ci <= i; ci++)
+			dry |= cell_dry(s, open, ci, cj);
+	return dry;
+}
+
+/* Node (i, j) under the weak condition: -1 prescribed (on a drained face, or no point of a full
+ * cell can reach it: cells i-S+1..i+1 by j-S+1..j+1 for support S), else 1 on the surface (next
+ * to full and dry cells), 2 a ghost node (next to no full cell), 0 inside. */
+static int weak_node(const struct sim *s, const int open[FACE_COUNT], idx_t i, idx_t j, int S)
+{
+	const struct grid *g = &s->grid;
+	int reached = 0, wet_next = 0;
+	for (idx_t cj = j - S + 1; cj <= j + 1; cj++)
+		for (idx_t ci = i - S + 1; ci <= i + 1; ci++)
+			reached |= ci >= 0 && cj >= 0 && ci < g->cells[0] && cj < g->cells[1] &&
+				   s->f.cell_wet[ci + cj * g->cells[0]];
+	if (!reached || on_drained_face(s, i, j))
+		return -1;
+	for (idx_t cj = j - 1; cj <= j; cj++)
+		for (idx_t ci = i - 1; ci <= i; ci++)
+			wet_next |= ci >= 0 && cj >= 0 && ci < g->cells[0] && cj < g->cells[1] &&
+				    s->f.cell_wet[ci + cj * g->cells[0]];
+	return !wet_next ? 2 : node_dry(s, open, i, j);
+}
+
 void free_surface_mark(struct sim *s)
 {
 	const struct grid *g = &s->grid;
@@ -176,23 +232,62 @@ void free_surface_mark(struct sim *s)
 	/* beyond a face where water moves freely is open air (dry); beyond a wall, nothing */
 	const int open[FACE_COUNT] = {bc[FACE_LEFT].water == CONSTRAINT_FREE, bc[FACE_RIGHT].water == CONSTRAINT_FREE,
 				      bc[FACE_BOTTOM].water == CONSTRAINT_FREE, bc[FACE_TOP].water == CONSTRAINT_FREE};
+	const int weak = s->spec->formulation.free_surface == FREE_SURFACE_WEAK;
+	const int S = shape_support(s->spec->formulation.shape);
 	mark_full_cells(s);
 	for (idx_t j = 0; j < g->nodes[1]; j++)
 		for (idx_t i = 0; i < g->nodes[0]; i++) {
-			int dry = on_drained_face(s, i, j);
-			for (idx_t cj = j - 1; cj <= j; cj++)
-				for (idx_t ci = i - 1; ci <= i; ci++)
-					dry |= cell_dry(s, open, ci, cj);
-			f->dirichlet[grid_node(g, i, j)] = (signed char)dry;
+			const idx_t I = grid_node(g, i, j);
+			if (weak) {
+				const int k = weak_node(s, open, i, j, S);
+				f->dirichlet[I] = (signed char)(k < 0);
+				f->surface[I] = (signed char)(k < 0 ? 0 : k);
+			} else {
+				f->dirichlet[I] = (signed char)node_dry(s, open, i, j);
+				f->surface[I] = 0;
+			}
 		}
-	memset(f->surface, 0, (size_t)g->node_count);
 	s->ps.sample_count = 0;
-	if (s->spec->formulation.free_surface == FREE_SURFACE_INTERPOLATED)
+	if (s->spec->formulation.free_surface != FREE_SURFACE_NODES)
 		place_surface(s, open);
+}
+
+/* The weak condition's boundary term: G_IJ -= sum_x a_x n_x S_I(x) S_J(x) over the surface
+ * points, into a gradient operator laid out as pressure.c's (row I, offsets of J within radius). */
+void free_surface_add_boundary_term(const struct sim *s, const double *mass, double *G)
+{
+	const struct grid *g = &s->grid;
+	const struct pressure_system *ps = &s->ps;
+	const enum case_shape kind = s->spec->formulation.shape;
+	const int S = shape_support(kind), W = ps->g_width, R = ps->g_radius;
+	double floor_mass = 0.0;
+	for (idx_t I = 0; I < g->node_count; I++)
+		floor_mass = fmax(floor_mass, mass[I]);
+	floor_mass *= BOUNDARY_MASS_FLOOR;
+	for (idx_t k = 0; k < ps->sample_count; k++) {
+		idx_t node0;
+		double w[SHAPE_NODES_MAX];
+		if (shape_weights_at(g, kind, ps->samples + 2 * k, &node0, w))
+			continue;
+		const double *nw = ps->sample_normal + 2 * k;
+		for (int a = 0; a < S * S; a++) {
+			const idx_t I = node0 + a % S + (a / S) * g->nodes[0];
+			if (mass[I] < floor_mass)
+				continue;
+			double *row = G + (size_t)I * W * W * 2;
+			for (int b = 0; b < S * S; b++) {
+				const int off = (b % S - a % S + R) + (b / S - a / S + R) * W;
+				row[2 * off] -= nw[0] * w[a] * w[b];
+				row[2 * off + 1] -= nw[1] * w[a] * w[b];
+			}
+		}
+	}
 }
 
 void free_surface_add_penalty(struct sim *s, double scale)
 {
+	if (s->spec->formulation.free_surface != FREE_SURFACE_INTERPOLATED)
+		return;
 	const struct grid *g = &s->grid;
 	struct grid_fields *f = &s->f;
 	struct pressure_system *ps = &s->ps;

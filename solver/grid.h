@@ -48,7 +48,9 @@ struct grid_fields {
 	signed char *cell_wet;   /* [cell_count] 1 if a pressure-carrying point lies in the cell */
 	signed char *dirichlet;  /* 1 if the pressure increment is prescribed at the node (free surface,
 				    drained face) */
-	signed char *surface;    /* 1 if the node takes the interpolated free-surface condition instead */
+	signed char *surface;    /* interpolated condition: 1 if the node takes it instead; weak
+				    condition (free_surface.c): 1 on the surface, 2 a ghost node beyond
+				    it, 3 a ghost node a penalty line ties to the field */
 	unsigned char *fix_s;    /* velocity constraint bits per node: 1 = x fixed, 2 = y fixed (soil) */
 	unsigned char *fix_w;    /* same for water */
 };

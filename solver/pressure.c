@@ -62,7 +62,8 @@ enum poro_status pressure_system_init(struct pressure_system *ps, const struct g
 	if (surface_points) {   /* at most two surface points on each of a full cell's four faces */
 		ps->sample_max = 8 * (idx_t)g->cell_count;
 		ps->samples = malloc(2 * (size_t)ps->sample_max * sizeof(double));
-		ok = ok && ps->samples;
+		ps->sample_normal = malloc(2 * (size_t)ps->sample_max * sizeof(double));
+		ok = ok && ps->samples && ps->sample_normal;
 	}
 	if (!ok) {
 		pressure_system_release(ps);
@@ -86,6 +87,7 @@ void pressure_system_release(struct pressure_system *ps)
 	free(ps->diagonal);
 	free(ps->interior);
 	free(ps->samples);
+	free(ps->sample_normal);
 	spd_solver_destroy(&ps->solver);
 	memset(ps, 0, sizeof *ps);
 }
@@ -149,6 +151,10 @@ void pressure_gradient_operators(struct sim *s)
 	memset(ps->grad_w, 0, sizeof(double) * nodes * gst);
 	add_gradient_operator(s, &s->soil, ps->grad_s);
 	add_gradient_operator(s, &s->water, ps->grad_w);
+	if (s->spec->formulation.free_surface == FREE_SURFACE_WEAK) {   /* free_surface.c */
+		free_surface_add_boundary_term(s, s->f.mass_s, ps->grad_s);
+		free_surface_add_boundary_term(s, s->f.mass_w, ps->grad_w);
+	}
 	for (size_t I = 0; I < nodes; I++) {
 		const double n = s->f.porosity[I];
 		for (size_t k = 0; k < gst; k++) {
@@ -384,7 +390,8 @@ enum poro_status pressure_solve(struct sim *s)
 	const struct particles *p = &s->soil, *w = &s->water;
 	double t0 = sim_clock();
 	memset(ps->stencil, 0, sizeof(double) * (size_t)s->grid.node_count * ps->width * ps->width);
-	free_surface_mark(s);
+	if (s->spec->formulation.free_surface != FREE_SURFACE_WEAK)
+		free_surface_mark(s);   /* weak: marked for G before the predictors (semi_implicit.c) */
 	double diagonal_mean = 0.0;
 	if (ps->exact) {
 		memset(s->f.rhs, 0, sizeof(double) * (size_t)s->grid.node_count);

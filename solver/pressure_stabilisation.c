@@ -27,6 +27,13 @@
  * drop over a cell; penalising those lines lets water through (an earlier penalty on the whole
  * field consolidated the k = 1e-9 column by a further 2-4% of the load in 2,000 steps). A grid face is not
  * an edge of the water: nodes beyond it do not exist and are not asked for.
+ *
+ * Ghost nodes. With the weak free-surface condition (free_surface.c) the nodes just beyond the
+ * surface are unknowns that only the tails of the shape functions and the surface points see;
+ * every line of three unknowns through one of them is penalised, whatever the case's
+ * pressure_stabilisation, so that the field beyond the surface is the smooth continuation of the
+ * field inside (a ghost penalty: it vanishes for pressures linear along the line). A ghost node
+ * no such line reaches is held at zero.
  */
 #include "sim_internal.h"
 
@@ -50,10 +57,21 @@ static void mark_interior(const struct sim *s, const double *diagonal, int margi
 	}
 }
 
+/* All three nodes of a line are pressure unknowns. */
+static int usable(const struct sim *s, const double *diagonal, const idx_t line[3])
+{
+	for (int a = 0; a < 3; a++)
+		if (!(diagonal[line[a]] > 0.0) || s->f.dirichlet[line[a]])
+			return 0;
+	return 1;
+}
+
 void pressure_stabilise(struct sim *s)
 {
 	const struct case_formulation *form = &s->spec->formulation;
-	if (form->pressure_stabilisation != PRESSURE_STABILISATION_SECOND_DIFFERENCE)
+	const int weak = form->free_surface == FREE_SURFACE_WEAK;
+	const int inner = form->pressure_stabilisation == PRESSURE_STABILISATION_SECOND_DIFFERENCE;
+	if (!inner && !weak)
 		return;
 	const struct grid *g = &s->grid;
 	struct grid_fields *f = &s->f;
@@ -72,7 +90,15 @@ void pressure_stabilise(struct sim *s)
 			if (d == 0 ? i == 0 || i == nx - 1 : j == 0 || j == ny - 1)
 				continue;
 			const idx_t line[3] = {J - step, J, J + step};
-			if (!ps->interior[line[0]] || !ps->interior[line[1]] || !ps->interior[line[2]])
+			const int ghost = weak && (f->surface[line[0]] >= 2 || f->surface[line[1]] >= 2 ||
+						   f->surface[line[2]] >= 2) &&
+					  usable(s, ps->diagonal, line);
+			for (int a = 0; ghost && a < 3; a++)
+				if (f->surface[line[a]] == 2)
+					f->surface[line[a]] = 3;   /* anchored */
+			const int interior = inner && ps->interior[line[0]] && ps->interior[line[1]] &&
+					     ps->interior[line[2]];
+			if (!ghost && !interior)
 				continue;
 			const double w = form->pressure_stabilisation_factor * ps->diagonal[J] / 6.0;
 			const double d2 = f->pressure[line[0]] - 2.0 * f->pressure[line[1]] + f->pressure[line[2]];
@@ -84,4 +110,7 @@ void pressure_stabilise(struct sim *s)
 			}
 		}
 	}
+	for (idx_t K = 0; weak && K < g->node_count; K++)
+		if (f->surface[K] == 2)   /* a ghost node no line ties to the field: held at zero */
+			f->dirichlet[K] = 1;
 }

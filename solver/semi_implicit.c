@@ -200,7 +200,10 @@ static void predict_velocities(struct sim *s)
 	const double dt = s->dt;
 	p2g_internal_force(&s->grid, p, p->volume, p->stress, NULL, f->force);
 	if (s->ps.exact) {
-		/* pressure forces through the same G the correction uses: G_w p^t and (G_s + G_w) p^t */
+		/* pressure forces through the same G the correction uses: G_w p^t and (G_s + G_w) p^t;
+		 * the weak free-surface condition's G needs the surface (step 5b) already */
+		if (s->spec->formulation.free_surface == FREE_SURFACE_WEAK)
+			free_surface_mark(s);
 		pressure_gradient_operators(s);
 		pressure_apply_gradient(s, s->ps.grad_w, f->pressure, f->force_w);
 		pressure_apply_gradient(s, s->ps.grad_w, f->pressure, f->force);
@@ -251,18 +254,28 @@ static void correct_velocities(struct sim *s)
 	const struct grid *g = &s->grid;
 	double *grad_s = s->soil_grad, *grad_w = s->water_vec;
 	const int drag = s->spec->formulation.drag_in_correction;
-	g2p_scalar_gradient(g, &s->soil, f->dp, grad_s);
-	p2g_vector(g, &s->soil, s->soil.volume, grad_s, f->correction_s);
-	g2p_scalar_gradient(g, &s->water, f->dp, grad_w);
-	p2g_vector(g, &s->water, s->water.volume, grad_w, f->correction_w);
+	/* with the weak free-surface condition G carries the surface's push (free_surface.c), which
+	 * a sum over the points cannot rebuild; G also carries the nodal porosity factors */
+	const int weak = s->spec->formulation.free_surface == FREE_SURFACE_WEAK;
+	if (weak) {
+		memset(f->correction_s, 0, 2 * sizeof(double) * (size_t)g->node_count);
+		memset(f->correction_w, 0, 2 * sizeof(double) * (size_t)g->node_count);
+		pressure_apply_gradient(s, s->ps.grad_s, f->dp, f->correction_s);
+		pressure_apply_gradient(s, s->ps.grad_w, f->dp, f->correction_w);
+	} else {
+		g2p_scalar_gradient(g, &s->soil, f->dp, grad_s);
+		p2g_vector(g, &s->soil, s->soil.volume, grad_s, f->correction_s);
+		g2p_scalar_gradient(g, &s->water, f->dp, grad_w);
+		p2g_vector(g, &s->water, s->water.volume, grad_w, f->correction_w);
+	}
 	for (idx_t I = 0; I < g->node_count; I++) {
-		const double n = f->porosity[I];
+		const double n = f->porosity[I], share_s = weak ? 1.0 : 1.0 - n, share_w = weak ? 1.0 : n;
 		for (int c = 0; c < 2; c++) {
 			const int k = 2 * I + c;
 			const struct phase_coupling K = phase_coupling_inverse(
 				f->mass_s[I], f->mass_w[I], drag ? f->drag_dt[I] : 0.0, f->fix_s[I] & (1 << c),
 				f->fix_w[I] & (1 << c));
-			const double f_s = s->dt * (1.0 - n) * f->correction_s[k], f_w = s->dt * n * f->correction_w[k];
+			const double f_s = s->dt * share_s * f->correction_s[k], f_w = s->dt * share_w * f->correction_w[k];
 			f->v_s[k] = f->mass_s[I] > 0.0 ? f->v_s_star[k] + K.ss * f_s + K.sw * f_w : 0.0;
 			f->v_w[k] = f->mass_w[I] > 0.0 ? f->v_w_star[k] + K.sw * f_s + K.ww * f_w : 0.0;
 		}

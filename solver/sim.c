@@ -173,7 +173,7 @@ static enum poro_status build(struct sim *s)
 		return st;
 	stabilisation_patches_init(s);
 	if ((st = pressure_system_init(&s->ps, &s->grid, s->soil.support, c->formulation.pressure_projection,
-				       c->formulation.free_surface == FREE_SURFACE_INTERPOLATED, &s->err)))
+				       c->formulation.free_surface != FREE_SURFACE_NODES, &s->err)))
 		return st;
 	boundary_mark(s);
 	loads_init(s);

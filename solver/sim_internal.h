@@ -33,8 +33,11 @@ struct pressure_system {
 	idx_t *colptr, *rowidx;   /* CSC upper triangle of the reduced system */
 	double *values, *b, *x;
 	double *diagonal;         /* [node_count] A's diagonal before the pressure stabilisation */
-	double *samples;          /* [2 sample_max] x, y of the interpolated free-surface condition's
-				     surface points (free_surface.c), m; NULL with the nodal condition */
+	double *samples;          /* [2 sample_max] x, y of the interpolated or weak free-surface
+				     condition's surface points (free_surface.c), m; NULL with the nodal
+				     condition */
+	double *sample_normal;    /* [2 sample_max] outward normal of each surface point's face times
+				     the point's share of the face's length, m (weak condition) */
 	idx_t sample_count, sample_max;
 	signed char *interior;    /* [node_count] 1: the stabilisation may act on the node */
 	struct spd_solver *solver;
@@ -94,19 +97,26 @@ enum poro_status pressure_system_init(struct pressure_system *ps, const struct g
 				      enum pressure_projection projection, int surface_points, struct poro_error *err);
 void pressure_system_release(struct pressure_system *ps);
 enum poro_status pressure_solve(struct sim *s);
-/* Adds the case's pressure stabilisation to the assembled consistent projection (stencil and
- * right-hand side); nothing when the case has none. pressure_stabilisation.c. */
+/* Adds the case's pressure stabilisation, and the weak free-surface condition's penalty on its
+ * ghost nodes, to the assembled consistent projection (stencil and right-hand side); a ghost node
+ * that no penalty line reaches is held at zero (f->dirichlet). pressure_stabilisation.c. */
 void pressure_stabilise(struct sim *s);
+/* G_s and G_w of the consistent projection into ps->grad_s, ps->grad_w (Eqs. 67-68 with the nodal
+ * porosity factors; with the weak free-surface condition, its surface term from the surface points
+ * free_surface_mark placed). */
 void pressure_gradient_operators(struct sim *s);
 void pressure_apply_gradient(const struct sim *s, const double *G, const double *pressure, double *out);
 
 /* free_surface.c: where p^{t+1} = 0 (000 §4.5 step 5b). free_surface_mark sets f->cell_wet,
- * f->dirichlet (prescribed nodes), f->surface and the surface points of the interpolated
- * condition; free_surface_add_penalty adds that condition's penalty, weighted by
+ * f->dirichlet (prescribed nodes), f->surface and the surface points of the interpolated and weak
+ * conditions; free_surface_add_penalty adds the interpolated condition's penalty, weighted by
  * free_surface_penalty_factor * scale, to the stencil and f->rhs among the numbered unknowns
- * (nothing with the nodal condition). */
+ * (nothing with the other conditions); free_surface_add_boundary_term subtracts the weak
+ * condition's surface integral sum_x a_x n_x S_I(x) S_J(x) from a gradient operator G laid out
+ * as pressure.c's, on the nodes where `mass` (the phase's nodal mass) is not negligible. */
 void free_surface_mark(struct sim *s);
 void free_surface_add_penalty(struct sim *s, double scale);
+void free_surface_add_boundary_term(const struct sim *s, const double *mass, double *G);
 
 /* boundary.c: velocity constraints of the grid faces (000 §4.5 steps 3e, 4d, 6d). */
 void boundary_mark(struct sim *s);

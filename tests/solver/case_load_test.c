@@ -368,7 +368,10 @@ static void test_out_of_range(void)
 		       "\"interpolated\"",
 		       "/formulation/free_surface: \"interpolated\" needs /formulation/pressure_projection \"consistent\"");
 	expect_invalid("unknown free surface", "/formulation/free_surface", "\"cells\"",
-		       "/formulation/free_surface: must be one of 'nodes', 'interpolated', got 'cells'");
+		       "/formulation/free_surface: must be one of 'nodes', 'interpolated', 'weak', got 'cells'");
+	expect_invalid("weak free surface without the consistent projection", "/formulation/free_surface",
+		       "\"weak\"",
+		       "/formulation/free_surface: \"weak\" needs /formulation/pressure_projection \"consistent\"");
 	expect_invalid("free surface penalty factor negative", "/formulation/free_surface_penalty_factor", "-1e4",
 		       "/formulation/free_surface_penalty_factor: must be > 0, got -10000");
 	{
@@ -380,6 +383,16 @@ static void test_out_of_range(void)
 		CHECK(c && c->formulation.free_surface == FREE_SURFACE_INTERPOLATED &&
 		      c->formulation.free_surface_penalty_factor == 385.2, "free surface read", "kind %d factor %g",
 		      c ? (int)c->formulation.free_surface : -1, c ? c->formulation.free_surface_penalty_factor : 0.0);
+		case_destroy(&c);
+		free(text);
+	}
+	{
+		const struct edit e[] = { { "/formulation/pressure_projection", "\"consistent\"" },
+					  { "/formulation/free_surface", "\"weak\"" } };
+		char *text = edited(full_case, e, 2);
+		struct case_spec *c = load_valid("weak free surface with the consistent projection", text);
+		CHECK(c && c->formulation.free_surface == FREE_SURFACE_WEAK, "weak free surface read", "kind %d",
+		      c ? (int)c->formulation.free_surface : -1);
 		case_destroy(&c);
 		free(text);
 	}

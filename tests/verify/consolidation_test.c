@@ -7,11 +7,15 @@
  *     (column.h): the theory is written in that coordinate, and the 1 mm settlement alone would
  *     otherwise add about 0.1% of q, more than the discretisation error;
  *  b. the same column drained at top and bottom against Terzaghi with drainage length H/2;
- *  c. k = 1e-9 m/s at the same dt: 2,000 steps, pore pressure within [0, 1.05 q], no NaN;
+ *  c. k = 1e-9 m/s at the same dt: 2,000 steps, pore pressure within [0, 1.05 q], no NaN, with
+ *     the case's weak free-surface condition (free_surface.c); the same formulation meets a at
+ *     k = 1e-3 m/s, and the paper's own overshoots (reported and checked to be seen);
  *  e. soil and water mass conserved to 1e-12 relative at every step, and the grid masses
  *     equal the point masses (partition of unity of the transfer);
- *  and the second-difference pressure stabilisation on the k = 1e-9 column with the consistent
- *  projection: the node-to-node pressure pattern gone, the column not drained by it; and the
+ *  and the weak free-surface condition on the Table 1 columns (requirement a with the k = 1e-9
+ *  case's formulation); the second-difference pressure stabilisation on the k = 1e-9 column with
+ *  the consistent projection: the node-to-node pressure pattern gone, the column not drained by
+ *  it; and the
  *  interpolated free-surface condition (free_surface.c): the Terzaghi errors with it, and the
  *  k = 1e-9 column's interior held at q for 2,000 steps.
  * Each figure is printed on an INFO line before the check that asserts it.
@@ -30,6 +34,7 @@
 
 static int consistent_projection;   /* run columns with formulation.pressure_projection "consistent" */
 static int interpolated_surface;    /* and with formulation.free_surface "interpolated" */
+static int weak_surface;            /* with the formulation of terzaghi_low_permeability.json */
 
 struct column {
 	double H, q, k, rho_w, mv, dt;
@@ -95,6 +100,17 @@ static int advance(struct sim *s, double t, double dt, double ms0, double mw0, d
 	return 1;
 }
 
+/* The formulation terzaghi_low_permeability.json runs with (requirement c): the consistent
+ * projection with drag in the correction, the second-difference stabilisation and the weak
+ * free-surface condition (free_surface.c). */
+static void use_low_permeability_formulation(struct case_spec *c)
+{
+	c->formulation.pressure_projection = PROJECTION_CONSISTENT;
+	c->formulation.drag_in_correction = 1;
+	c->formulation.pressure_stabilisation = PRESSURE_STABILISATION_SECOND_DIFFERENCE;
+	c->formulation.free_surface = FREE_SURFACE_WEAK;
+}
+
 /* Runs a column case to each Tv; rms[i] gets the normalised RMS error there. Returns 0 on failure. */
 static int run_column(const char *file, double cell_size, double dt, const char *phases, const double *Tv, int nTv,
 		      double *rms, double *mass_drift, double *grid_err)
@@ -113,6 +129,8 @@ static int run_column(const char *file, double cell_size, double dt, const char 
 		c->formulation.pressure_projection = PROJECTION_CONSISTENT;
 	if (interpolated_surface)
 		c->formulation.free_surface = FREE_SURFACE_INTERPOLATED;
+	if (weak_surface)
+		use_low_permeability_formulation(c);
 	if (phases)
 		c->formulation.phases = !strcmp(phases, "single_point") ? PHASES_SINGLE_POINT : PHASES_DOUBLE_POINT;
 	struct sim *s = NULL;
@@ -176,39 +194,98 @@ static void check_double_drained(void)
 	}
 }
 
-static void check_low_permeability(void)
+/* The k = 1e-9 column for 2,000 steps: *pmin, *pmax the extreme point pressures over q, *dt the
+ * step. With `paper` the paper's own formulation (Laplacian, Eq. 65 without drag, p = 0 on the
+ * nodes next to the surface) replaces the case's. Returns 0 on failure. */
+static int run_low_permeability(int paper, double *pmin, double *pmax, double *dt)
 {
 	struct case_spec *c = NULL;
 	struct poro_error err = {0};
 	struct sim *s = NULL;
-	int ok = !case_load_file(CASES "terzaghi_low_permeability.json", &c, &err) && !sim_create(&s, c, &err);
-	double q = ok ? -c->loads[0].traction[1] : 1, pmin = 1e300, pmax = -1e300;
+	int ok = !case_load_file(CASES "terzaghi_low_permeability.json", &c, &err);
+	if (ok && paper) {
+		c->formulation.pressure_projection = PROJECTION_LAPLACIAN;
+		c->formulation.drag_in_correction = 0;
+		c->formulation.pressure_stabilisation = PRESSURE_STABILISATION_NONE;
+		c->formulation.free_surface = FREE_SURFACE_NODES;
+	}
+	ok = ok && !sim_create(&s, c, &err);
+	const double q = ok ? -c->loads[0].traction[1] : 1;
+	*pmin = INFINITY, *pmax = -INFINITY, *dt = ok ? c->time.dt : 0;
 	long steps = 0;
+	idx_t n = ok ? sim_pressure_point_count(s) : 0;
+	double *p = malloc(sizeof *p * (size_t)(n + 1));
 	while (ok && steps < 2000) {
-		ok = !sim_step(s);
+		ok = !sim_step(s) && p;
 		steps++;
-		idx_t n = sim_pressure_point_count(s);
-		double p[n];
+		if (!ok)
+			break;
 		sim_pore_pressure(s, p, NULL);
 		for (idx_t i = 0; i < n; i++) {
 			if (!isfinite(p[i]))
 				ok = 0;
-			pmin = fmin(pmin, p[i]), pmax = fmax(pmax, p[i]);
+			*pmin = fmin(*pmin, p[i] / q), *pmax = fmax(*pmax, p[i] / q);
 		}
 	}
-	printf("INFO k=1e-9 dt=%.1e: %ld steps, pore pressure in [%.4f, %.4f] q\n", ok ? c->time.dt : 0, steps, pmin / q, pmax / q);
-	CHECK(ok && steps == 2000, "low_permeability_runs_2000_steps", "%s", ok ? "" : (s ? sim_error(s)->message : err.message));
-	CHECK(ok && pmin >= -1e-9 * q, "low_permeability_pressure_non_negative", "minimum %.4f q", pmin / q);
-	/* Not met yet: k = 1e-9 m/s allows a drainage layer of sqrt(c_v t) ~ 0.5 mm, far below h.
-	 * With the nodal surface condition the pressure force misses the part of the drop to zero
-	 * that lies outside the points, and the interior rises above q; the interpolated condition
-	 * (consistent projection only, check_low_permeability_interpolated below) keeps the interior
-	 * at q, but within three cells of the surface the pressure still swings above 1.05 q
-	 * (docs/numerics.md, "Free surface"). */
-	CHECK_KNOWN_FAILURE(ok && pmax <= 1.05 * q, "low_permeability_pressure_at_most_1.05q",
-			    "maximum %.4f q after %ld steps", pmax / q, steps);
+	if (!ok)
+		printf("INFO k=1e-9 column failed after %ld steps: %s\n", steps, s ? sim_error(s)->message : err.message);
+	free(p);
 	sim_destroy(&s);
 	case_destroy(&c);
+	return ok;
+}
+
+/* Requirement c on the case as written. The paper's formulation runs the same 2,000 steps but
+ * overshoots from the first step (the pressure force sees only part of the drop to zero at the
+ * nodes next to the surface; docs/numerics.md, "Free surface"): checked to be seen, so that the
+ * bound above is the weak condition's doing. The same formulation at k = 1e-3 m/s and the same
+ * dt meets requirement a (check_weak_surface). */
+#define PAPER_OVERSHOOT_MIN 1.2   /* q (measured 1.39) */
+static void check_low_permeability(void)
+{
+	double pmin = 0, pmax = 0, dt = 0, paper_min = 0, paper_max = 0, paper_dt = 0;
+	int ok = run_low_permeability(0, &pmin, &pmax, &dt);
+	int paper_ok = run_low_permeability(1, &paper_min, &paper_max, &paper_dt);
+	printf("INFO k=1e-9 dt=%.1e: 2000 steps, pore pressure in [%.4f, %.4f] q; the paper's formulation "
+	       "(Laplacian, nodal surface) [%.4f, %.4f] q\n", dt, pmin, pmax, paper_min, paper_max);
+	CHECK(ok, "low_permeability_runs_2000_steps", "see the INFO line");
+	CHECK(ok && pmin >= 0, "low_permeability_pressure_non_negative", "minimum %.4f q", pmin);
+	CHECK(ok && pmax <= 1.05, "low_permeability_pressure_at_most_1.05q", "maximum %.4f q", pmax);
+	CHECK(paper_ok && paper_min >= 0, "low_permeability_paper_formulation_runs_2000_steps",
+	      "minimum %.4f q", paper_min);
+	CHECK(paper_ok && paper_max >= PAPER_OVERSHOOT_MIN, "low_permeability_paper_formulation_overshoot_seen",
+	      "maximum %.4f q (the measure must see it)", paper_max);
+}
+
+/* Requirement a with the low-permeability case's formulation (use_low_permeability_formulation):
+ * the Table 1 columns, double and single point, at k = 1e-3 m/s and the dt of the k = 1e-9 case,
+ * within 2% and better at h/2. */
+static void check_weak_surface(void)
+{
+	const double Tv[4] = {0.1, 0.2, 0.5, 1.0};
+	const char *files[2] = {CASES "terzaghi.json", CASES "terzaghi_single_point.json"};
+	const char *labels[2] = {"double_point", "single_point"};
+	weak_surface = 1;
+	for (int f = 0; f < 2; f++) {
+		double rms[4] = {0}, fine[2] = {0}, drift, grid_err, worst = 0, coarse_mean = 0, fine_mean = 0;
+		int ok = run_column(files[f], 0, 0, NULL, Tv, 4, rms, &drift, &grid_err) &&
+			 run_column(files[f], 0.0125, 0.5e-4, NULL, Tv, 2, fine, &drift, &grid_err);
+		for (int i = 0; i < 4; i++) {
+			printf("INFO terzaghi %s weak free surface Tv=%.1f rms/q=%.5f (h)\n", labels[f], Tv[i], rms[i]);
+			worst = fmax(worst, rms[i]);
+		}
+		for (int i = 0; i < 2; i++) {
+			printf("INFO terzaghi %s weak free surface Tv=%.1f rms/q=%.5f (h/2)\n", labels[f], Tv[i], fine[i]);
+			coarse_mean += rms[i] / 2, fine_mean += fine[i] / 2;
+		}
+		char name[128];
+		snprintf(name, sizeof name, "terzaghi_%s_weak_surface_rms_below_2pct", labels[f]);
+		CHECK(ok && worst <= 0.02, name, "worst rms/q %.5f", worst);
+		snprintf(name, sizeof name, "terzaghi_%s_weak_surface_error_falls_with_h", labels[f]);
+		CHECK(ok && fine_mean < coarse_mean, name, "mean rms/q at Tv 0.1-0.2 %.5f (h) vs %.5f (h/2)",
+		      coarse_mean, fine_mean);
+	}
+	weak_surface = 0;
 }
 
 /* The k = 1e-9 column under the consistent projection with drag in the correction, with or
@@ -336,7 +413,7 @@ static void check_consistent_projection(int interpolated)
  * mean pressure of the middle half of the column from the second step on (the first is the
  * sudden load's, within 3%: free_surface_test), and the range over all points. The middle stays
  * at q; within three cells of the surface the pressure still swings (up to about 1.46 q), which
- * requirement c's bound on every point does not allow (the XFAIL above, for the case as written). */
+ * requirement c's bound on every point does not allow (the case uses the weak condition). */
 #define LOW_K_INTERIOR_TOLERANCE 0.01   /* q (measured 0.997-1.003) */
 static void check_low_permeability_interpolated(void)
 {
@@ -380,7 +457,7 @@ static void check_low_permeability_interpolated(void)
 }
 
 /* With an argument, runs only the named group (double_point, single_point, drained, low_k,
- * consistent, stabilisation, free_surface). */
+ * weak_surface, consistent, stabilisation, free_surface). */
 int main(int argc, char **argv)
 {
 	const char *only = argc > 1 ? argv[1] : NULL;
@@ -393,6 +470,8 @@ int main(int argc, char **argv)
 		check_double_drained();
 	if (WANT("low_k"))
 		check_low_permeability();
+	if (WANT("weak_surface"))
+		check_weak_surface();
 	if (WANT("consistent"))
 		check_consistent_projection(0);
 	if (WANT("free_surface")) {
