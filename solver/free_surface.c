@@ -167,7 +167,7 @@ static void add_surface_face(struct sim *s, idx_t ci, idx_t cj, int dx, int dy)
 		const idx_t I = grid_node(g, i, j);
 		if (s->f.dirichlet[I] && !on_drained_face(s, i, j)) {
 			s->f.dirichlet[I] = 0;
-			s->f.surface[I] = 1;
+			s->f.surface[I] = SURFACE_ON;
 		}
 	}
 }
@@ -205,8 +205,8 @@ static int node_dry(const struct sim *s, const int open[FACE_COUNT], idx_t i, id
 }
 
 /* Node (i, j) under the weak condition: -1 prescribed (on a drained face, or no point of a full
- * cell can reach it: cells i-S+1..i+1 by j-S+1..j+1 for support S), else 1 on the surface (next
- * to full and dry cells), 2 a ghost node (next to no full cell), 0 inside. */
+ * cell can reach it: cells i-S+1..i+1 by j-S+1..j+1 for support S), else its enum surface_node:
+ * on the surface (next to full and dry cells), a ghost node (next to no full cell), or none. */
 static int weak_node(const struct sim *s, const int open[FACE_COUNT], idx_t i, idx_t j, int S)
 {
 	const struct grid *g = &s->grid;
@@ -221,7 +221,7 @@ static int weak_node(const struct sim *s, const int open[FACE_COUNT], idx_t i, i
 		for (idx_t ci = i - 1; ci <= i; ci++)
 			wet_next |= ci >= 0 && cj >= 0 && ci < g->cells[0] && cj < g->cells[1] &&
 				    s->f.cell_wet[ci + cj * g->cells[0]];
-	return !wet_next ? 2 : node_dry(s, open, i, j);
+	return !wet_next ? SURFACE_GHOST : node_dry(s, open, i, j) ? SURFACE_ON : SURFACE_NONE;
 }
 
 void free_surface_mark(struct sim *s)
@@ -241,10 +241,10 @@ void free_surface_mark(struct sim *s)
 			if (weak) {
 				const int k = weak_node(s, open, i, j, S);
 				f->dirichlet[I] = (signed char)(k < 0);
-				f->surface[I] = (signed char)(k < 0 ? 0 : k);
+				f->surface[I] = (signed char)(k < 0 ? SURFACE_NONE : k);
 			} else {
 				f->dirichlet[I] = (signed char)node_dry(s, open, i, j);
-				f->surface[I] = 0;
+				f->surface[I] = SURFACE_NONE;
 			}
 		}
 	s->ps.sample_count = 0;

@@ -48,9 +48,8 @@ struct grid_fields {
 	signed char *cell_wet;   /* [cell_count] 1 if a pressure-carrying point lies in the cell */
 	signed char *dirichlet;  /* 1 if the pressure increment is prescribed at the node (free surface,
 				    drained face) */
-	signed char *surface;    /* interpolated condition: 1 if the node takes it instead; weak
-				    condition (free_surface.c): 1 on the surface, 2 a ghost node beyond
-				    it, 3 a ghost node a penalty line ties to the field */
+	signed char *surface;    /* enum surface_node (sim_internal.h): the node's part in the
+				    interpolated or weak free-surface condition */
 	unsigned char *fix_s;    /* velocity constraint bits per node: 1 = x fixed, 2 = y fixed (soil) */
 	unsigned char *fix_w;    /* same for water */
 };

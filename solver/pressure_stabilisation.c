@@ -90,12 +90,13 @@ void pressure_stabilise(struct sim *s)
 			if (d == 0 ? i == 0 || i == nx - 1 : j == 0 || j == ny - 1)
 				continue;
 			const idx_t line[3] = {J - step, J, J + step};
-			const int ghost = weak && (f->surface[line[0]] >= 2 || f->surface[line[1]] >= 2 ||
-						   f->surface[line[2]] >= 2) &&
+			const int ghost = weak && (f->surface[line[0]] >= SURFACE_GHOST ||
+						   f->surface[line[1]] >= SURFACE_GHOST ||
+						   f->surface[line[2]] >= SURFACE_GHOST) &&
 					  usable(s, ps->diagonal, line);
 			for (int a = 0; ghost && a < 3; a++)
-				if (f->surface[line[a]] == 2)
-					f->surface[line[a]] = 3;   /* anchored */
+				if (f->surface[line[a]] == SURFACE_GHOST)
+					f->surface[line[a]] = SURFACE_GHOST_TIED;
 			const int interior = inner && ps->interior[line[0]] && ps->interior[line[1]] &&
 					     ps->interior[line[2]];
 			if (!ghost && !interior)
@@ -111,6 +112,6 @@ void pressure_stabilise(struct sim *s)
 		}
 	}
 	for (idx_t K = 0; weak && K < g->node_count; K++)
-		if (f->surface[K] == 2)   /* a ghost node no line ties to the field: held at zero */
+		if (f->surface[K] == SURFACE_GHOST)   /* no line ties it to the field: held at zero */
 			f->dirichlet[K] = 1;
 }
