@@ -116,12 +116,19 @@ static void mark_full_cells(struct sim *s)
 	}
 }
 
+/* Cell (ci, cj) lies inside the grid and is full. */
+static int cell_full(const struct sim *s, idx_t ci, idx_t cj)
+{
+	const struct grid *g = &s->grid;
+	return ci >= 0 && cj >= 0 && ci < g->cells[0] && cj < g->cells[1] && s->f.cell_wet[ci + cj * g->cells[0]];
+}
+
 /* Cell (ci, cj), inside the grid or beyond a face, counts as dry: not full, or open air. */
 static int cell_dry(const struct sim *s, const int open[FACE_COUNT], idx_t ci, idx_t cj)
 {
 	const struct grid *g = &s->grid;
 	if (ci >= 0 && cj >= 0 && ci < g->cells[0] && cj < g->cells[1])
-		return !s->f.cell_wet[ci + cj * g->cells[0]];
+		return !cell_full(s, ci, cj);
 	return (ci < 0 && open[FACE_LEFT]) || (ci >= g->cells[0] && open[FACE_RIGHT]) ||
 	       (cj < 0 && open[FACE_BOTTOM]) || (cj >= g->cells[1] && open[FACE_TOP]);
 }
@@ -209,18 +216,15 @@ static int node_dry(const struct sim *s, const int open[FACE_COUNT], idx_t i, id
  * on the surface (next to full and dry cells), a ghost node (next to no full cell), or none. */
 static int weak_node(const struct sim *s, const int open[FACE_COUNT], idx_t i, idx_t j, int S)
 {
-	const struct grid *g = &s->grid;
 	int reached = 0, wet_next = 0;
 	for (idx_t cj = j - S + 1; cj <= j + 1; cj++)
 		for (idx_t ci = i - S + 1; ci <= i + 1; ci++)
-			reached |= ci >= 0 && cj >= 0 && ci < g->cells[0] && cj < g->cells[1] &&
-				   s->f.cell_wet[ci + cj * g->cells[0]];
+			reached |= cell_full(s, ci, cj);
 	if (!reached || on_drained_face(s, i, j))
 		return -1;
 	for (idx_t cj = j - 1; cj <= j; cj++)
 		for (idx_t ci = i - 1; ci <= i; ci++)
-			wet_next |= ci >= 0 && cj >= 0 && ci < g->cells[0] && cj < g->cells[1] &&
-				    s->f.cell_wet[ci + cj * g->cells[0]];
+			wet_next |= cell_full(s, ci, cj);
 	return !wet_next ? SURFACE_GHOST : node_dry(s, open, i, j) ? SURFACE_ON : SURFACE_NONE;
 }
 

@@ -1,6 +1,7 @@
 /*
- * pressure.c - the pore-pressure increment of the semi-implicit scheme (000 §4.5 step 5):
- * free-surface detection, the pressure matrix and right-hand side, and the solve.
+ * pressure.c - the pore-pressure increment of the semi-implicit scheme (000 §4.5 step 5): the
+ * pressure matrix and right-hand side, and the solve (the free surface, step 5b, is marked before
+ * the predictors: free_surface.c, semi_implicit.c).
  *
  * Two matrices are offered (case key formulation.pressure_projection):
  *  - "laplacian" (default, the paper): L dp = (D_s v_s* + D_w v_w*) / dt, Eqs. 60-63. L (Eq. 61) is
@@ -390,8 +391,6 @@ enum poro_status pressure_solve(struct sim *s)
 	const struct particles *p = &s->soil, *w = &s->water;
 	double t0 = sim_clock();
 	memset(ps->stencil, 0, sizeof(double) * (size_t)s->grid.node_count * ps->width * ps->width);
-	if (s->spec->formulation.free_surface != FREE_SURFACE_WEAK)
-		free_surface_mark(s);   /* weak: marked for G before the predictors (semi_implicit.c) */
 	double diagonal_mean = 0.0;
 	if (ps->exact) {
 		memset(s->f.rhs, 0, sizeof(double) * (size_t)s->grid.node_count);

@@ -37,6 +37,12 @@
  */
 #include "sim_internal.h"
 
+/* Node K is a pressure unknown: active (positive diagonal) and not prescribed. */
+static int is_unknown(const struct sim *s, const double *diagonal, idx_t K)
+{
+	return diagonal[K] > 0.0 && !s->f.dirichlet[K];
+}
+
 /* Marks the nodes whose neighbourhood of radius `margin` (inside the grid) holds only pressure
  * unknowns away from the surface: active (positive diagonal), not prescribed, and not holding the
  * interpolated free-surface condition (free_surface.c), where the pressure drops to zero within
@@ -51,19 +57,9 @@ static void mark_interior(const struct sim *s, const double *diagonal, int margi
 		for (idx_t b = j - margin; inside && b <= j + margin; b++)
 			for (idx_t a = i - margin; inside && a <= i + margin; a++)
 				if (a >= 0 && a < nx && b >= 0 && b < ny)
-					inside = diagonal[a + b * nx] > 0.0 && !s->f.dirichlet[a + b * nx] &&
-						 !s->f.surface[a + b * nx];
+					inside = is_unknown(s, diagonal, a + b * nx) && !s->f.surface[a + b * nx];
 		interior[K] = (signed char)inside;
 	}
-}
-
-/* All three nodes of a line are pressure unknowns. */
-static int usable(const struct sim *s, const double *diagonal, const idx_t line[3])
-{
-	for (int a = 0; a < 3; a++)
-		if (!(diagonal[line[a]] > 0.0) || s->f.dirichlet[line[a]])
-			return 0;
-	return 1;
 }
 
 void pressure_stabilise(struct sim *s)
@@ -93,7 +89,8 @@ void pressure_stabilise(struct sim *s)
 			const int ghost = weak && (f->surface[line[0]] >= SURFACE_GHOST ||
 						   f->surface[line[1]] >= SURFACE_GHOST ||
 						   f->surface[line[2]] >= SURFACE_GHOST) &&
-					  usable(s, ps->diagonal, line);
+					  is_unknown(s, ps->diagonal, line[0]) && is_unknown(s, ps->diagonal, line[1]) &&
+					  is_unknown(s, ps->diagonal, line[2]);
 			for (int a = 0; ghost && a < 3; a++)
 				if (f->surface[line[a]] == SURFACE_GHOST)
 					f->surface[line[a]] = SURFACE_GHOST_TIED;

@@ -200,10 +200,7 @@ static void predict_velocities(struct sim *s)
 	const double dt = s->dt;
 	p2g_internal_force(&s->grid, p, p->volume, p->stress, NULL, f->force);
 	if (s->ps.exact) {
-		/* pressure forces through the same G the correction uses: G_w p^t and (G_s + G_w) p^t;
-		 * the weak free-surface condition's G needs the surface (step 5b) already */
-		if (s->spec->formulation.free_surface == FREE_SURFACE_WEAK)
-			free_surface_mark(s);
+		/* pressure forces through the same G the correction uses: G_w p^t and (G_s + G_w) p^t */
 		pressure_gradient_operators(s);
 		pressure_apply_gradient(s, s->ps.grad_w, f->pressure, f->force_w);
 		pressure_apply_gradient(s, s->ps.grad_w, f->pressure, f->force);
@@ -587,6 +584,9 @@ enum poro_status semi_implicit_step(struct sim *s)
 		project_porosity_to_water(s);                                /* (8h-i) of the last step */
 		map_water_to_grid(s);                                        /* (2e-f) */
 	});
+	/* (5b) ahead of the predictors: the weak free-surface condition's G (free_surface.c) needs
+	 * the surface, and nothing it reads changes before the pressure solve */
+	PHASE(PHASE_PRESSURE_ASSEMBLY, free_surface_mark(s));
 	PHASE(PHASE_PREDICT, predict_velocities(s));                         /* (3)-(4) Eqs. 52-53 */
 	TRY(pressure_solve(s));                                              /* (5) Eq. 60 */
 	PHASE(PHASE_CORRECT, correct_velocities(s));                         /* (6) Eqs. 64-65 */

@@ -107,6 +107,12 @@ void pressure_stabilise(struct sim *s);
 void pressure_gradient_operators(struct sim *s);
 void pressure_apply_gradient(const struct sim *s, const double *G, const double *pressure, double *out);
 
+/* f->surface: SURFACE_ON, a node on the surface (interpolated condition: it takes the condition
+ * instead of p = 0; weak: next to full and dry cells); SURFACE_GHOST, weak condition, a node beyond
+ * the surface that points of full cells reach; SURFACE_GHOST_TIED, such a node that a penalty
+ * line ties to the field inside (pressure_stabilisation.c). */
+enum surface_node { SURFACE_NONE, SURFACE_ON, SURFACE_GHOST, SURFACE_GHOST_TIED };
+
 /* free_surface.c: where p^{t+1} = 0 (000 §4.5 step 5b). free_surface_mark sets f->cell_wet,
  * f->dirichlet (prescribed nodes), f->surface and the surface points of the interpolated and weak
  * conditions; free_surface_add_penalty adds the interpolated condition's penalty, weighted by
@@ -114,11 +120,6 @@ void pressure_apply_gradient(const struct sim *s, const double *G, const double 
  * (nothing with the other conditions); free_surface_add_boundary_term subtracts the weak
  * condition's surface integral sum_x a_x n_x S_I(x) S_J(x) from a gradient operator G laid out
  * as pressure.c's, on the nodes where `mass` (the phase's nodal mass) is not negligible. */
-/* f->surface: SURFACE_ON, a node on the surface (interpolated condition: it takes the condition
- * instead of p = 0; weak: next to full and dry cells); SURFACE_GHOST, weak condition, a node beyond
- * the surface that points of full cells reach; SURFACE_GHOST_TIED, such a node that a penalty
- * line ties to the field inside (pressure_stabilisation.c). */
-enum surface_node { SURFACE_NONE, SURFACE_ON, SURFACE_GHOST, SURFACE_GHOST_TIED };
 void free_surface_mark(struct sim *s);
 void free_surface_add_penalty(struct sim *s, double scale);
 void free_surface_add_boundary_term(const struct sim *s, const double *mass, double *G);
