@@ -137,10 +137,12 @@ static void add_through_points(struct sim *s, int l, double scale, double *force
 		 * normal to y, F_yy / J for one normal to x */
 		const double *F = p->F + 4 * q;
 		const double N_grad_phi = (axis == 1 ? F[0] : F[3]) / ((F[0] * F[3] - F[1] * F[2]) * D);
-		const double *w = p->w + (size_t)q * nn, *dw = p->dw + (size_t)q * 2 * nn;
+		const struct shape_factors f = particle_shape(p, q);
 		for (int k = 0; k < nn; k++) {
-			const idx_t I = p->node0[q] + k % S + (k / S) * nx;
-			const double g = p->volume[q] * (phi * sign * dw[2 * k + axis] + w[k] * N_grad_phi);
+			const int a = k % S, b = k / S;
+			const idx_t I = p->node0[q] + a + b * nx;
+			const double gradient = axis == 0 ? f.dx[a] * f.wy[b] : f.wx[a] * f.dy[b];
+			const double g = p->volume[q] * (phi * sign * gradient + f.wx[a] * f.wy[b] * N_grad_phi);
 			force[2 * I] += tx * g;
 			force[2 * I + 1] += ty * g;
 		}

@@ -13,7 +13,7 @@
 	X(stress, 4, skel) X(F, 4, skel) X(Be, 4, skel)            \
 	X(state, STATE_MAX, skel) X(plastic_strain, 1, skel)       \
 	X(dF, 4, skel) X(surface, 2, skel)                         \
-	X(w, SHAPE_NODES_MAX, !alias) X(dw, 2 * SHAPE_NODES_MAX, !alias)
+	X(shape, 4 * SHAPE_SUPPORT_MAX, !alias)
 
 static enum poro_status allocate(struct particles *p, idx_t n, int skel, int alias, struct poro_error *err)
 {
@@ -60,8 +60,7 @@ enum poro_status particles_init_alias(struct particles *w, const struct particle
 	w->conductivity = soil->conductivity;
 	w->body = soil->body;
 	w->node0 = soil->node0;
-	w->w = soil->w;
-	w->dw = soil->dw;
+	w->shape = soil->shape;
 	w->support = soil->support;
 	return PORO_OK;
 }
@@ -87,7 +86,7 @@ void particles_release(struct particles *p)
 	if (!p->alias_of) {
 		free(p->x); free(p->x0); free(p->volume); free(p->volume0);
 		free(p->porosity); free(p->porosity0); free(p->conductivity);
-		free(p->w); free(p->dw); free(p->body); free(p->node0);
+		free(p->shape); free(p->body); free(p->node0);
 	}
 	free(p->v); free(p->mass); free(p->pressure);
 	free(p->stress); free(p->F); free(p->Be); free(p->state); free(p->plastic_strain);

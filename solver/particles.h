@@ -57,9 +57,25 @@ struct particles {
 	/* shape-function cache, filled once per step by shape_evaluate() (000 §4.5 step 1) */
 	int support;                /* nodes per direction of the current shape function */
 	idx_t *node0;               /* [n] linear index of the lower-left support node */
-	double *w;                  /* [SHAPE_NODES_MAX n] weights S_Ip, node order i fastest */
-	double *dw;                 /* [2 SHAPE_NODES_MAX n] gradients dS/dx, dS/dy interleaved */
+	double *shape;              /* [4 SHAPE_SUPPORT_MAX n] the 1-D factors of S_Ip: point q's block of
+				       4 support values at 4 support q (see particle_shape) */
 };
+
+/* The shape functions are tensor products: for the support node a + b support (a along x, b
+ * along y) S_Ip = wx[a] wy[b] and grad S_Ip = (dx[a] wy[b], wx[a] dy[b]), dx and dy per metre.
+ * The cache keeps the 4 support 1-D factors rather than the 3 support^2 products (12 values a
+ * point instead of 27 for quadratic B-splines): the loops that use them form the products as
+ * they go, which costs less than moving the products through memory. */
+struct shape_factors {
+	const double *wx, *wy, *dx, *dy;   /* [support] each */
+};
+
+static inline struct shape_factors particle_shape(const struct particles *p, idx_t q)
+{
+	const int S = p->support;
+	const double *f = p->shape + (size_t)q * 4 * S;
+	return (struct shape_factors){ f, f + S, f + 2 * S, f + 3 * S };
+}
 
 /* Allocates a set of n points with every array zeroed; soil sets also get the skeleton arrays.
  * Returns PORO_ENOMEM on failure with nothing allocated. */

@@ -98,21 +98,19 @@ static void assemble_laplacian(struct sim *s, const struct particles *p, const d
 {
 	const struct grid *g = &s->grid;
 	struct pressure_system *ps = &s->ps;
-	const int S = p->support, nn = S * S, W = ps->width, R = ps->radius;
+	const int S = p->support, W = ps->width, R = ps->radius;
 	for (idx_t q = 0; q < p->n; q++) {
-		const double *dw = p->dw + (size_t)q * 2 * nn;
+		const struct shape_factors f = particle_shape(p, q);   /* grad S = (dx wy, wx dy) */
 		const double c = coef[q];
 		for (int ky = 0; ky < S; ky++)
 			for (int kx = 0; kx < S; kx++) {
-				const int k = kx + ky * S;
 				const idx_t I = p->node0[q] + kx + ky * g->nodes[0];
 				double *row = ps->stencil + (size_t)I * W * W;
-				const double gx = c * dw[2 * k], gy = c * dw[2 * k + 1];
+				const double gx = c * (f.dx[kx] * f.wy[ky]), gy = c * (f.wx[kx] * f.dy[ky]);
 				for (int ly = 0; ly < S; ly++) {   /* one grid line of J: adjacent entries */
 					double *dst = row + (R - kx) + (ly - ky + R) * W;
-					const double *src = dw + 2 * ly * S;
 					for (int lx = 0; lx < S; lx++)
-						dst[lx] += gx * src[2 * lx] + gy * src[2 * lx + 1];
+						dst[lx] += gx * (f.dx[lx] * f.wy[ly]) + gy * (f.wx[lx] * f.dy[ly]);
 				}
 			}
 	}
@@ -123,22 +121,23 @@ static void add_gradient_operator(const struct sim *s, const struct particles *p
 {
 	const struct grid *g = &s->grid;
 	const struct pressure_system *ps = &s->ps;
-	const int S = p->support, nn = S * S, W = ps->g_width, R = ps->g_radius;
+	const int S = p->support, W = ps->g_width, R = ps->g_radius;
 	for (idx_t q = 0; q < p->n; q++) {
-		const double *w = p->w + (size_t)q * nn, *dw = p->dw + (size_t)q * 2 * nn;
+		const struct shape_factors f = particle_shape(p, q);   /* S = wx wy, grad S = (dx wy, wx dy) */
 		const double V = p->volume[q];
 		for (int ky = 0; ky < S; ky++)
 			for (int kx = 0; kx < S; kx++) {
 				const idx_t I = p->node0[q] + kx + ky * g->nodes[0];
 				double *row = G + (size_t)I * W * W * 2;
-				const double vs = V * w[kx + ky * S];
-				/* the support nodes J of one grid line are adjacent in the row and in dw:
-				 * 2 S contiguous products per line */
+				const double vs = V * (f.wx[kx] * f.wy[ky]);
+				/* the support nodes J of one grid line are adjacent in the row: 2 S
+				 * contiguous entries per line */
 				for (int ly = 0; ly < S; ly++) {
 					double *dst = row + 2 * ((R - kx) + (ly - ky + R) * W);
-					const double *src = dw + 2 * ly * S;
-					for (int t = 0; t < 2 * S; t++)
-						dst[t] += vs * src[t];
+					for (int lx = 0; lx < S; lx++) {
+						dst[2 * lx] += vs * (f.dx[lx] * f.wy[ly]);
+						dst[2 * lx + 1] += vs * (f.wx[lx] * f.dy[ly]);
+					}
 				}
 			}
 	}

@@ -136,32 +136,21 @@ int shape_weights_at(const struct grid *g, enum case_shape kind, const double x[
 	return 0;
 }
 
-/* The shape cache of point q: node0, and the S^2 weights and gradients as tensor products of the
- * 1-D functions. Returns -1 if the point lies outside the grid. Called with constant kind and S,
- * so that each kind gets its own unrolled copy: the 1-D dispatch and the loop bounds fold away
- * (the water points of double point double this phase, 000 §5.3). The products are those of the
- * general loop, in the same order, so the cache is bit for bit the same. */
+/* The shape cache of point q: node0 and the 1-D factors (particles.h, particle_shape), written in
+ * place. Returns -1 if the point lies outside the grid. Called with constant kind and S, so that
+ * each kind gets its own copy with the 1-D dispatch folded away (the water points of double
+ * point double this phase, 000 §5.3). */
 static inline int evaluate_point(const struct grid *g, enum case_shape kind, const int S, struct particles *p,
 				 idx_t q)
 {
-	double wx[SHAPE_SUPPORT_MAX], wy[SHAPE_SUPPORT_MAX], dx[SHAPE_SUPPORT_MAX], dy[SHAPE_SUPPORT_MAX];
+	double *f = p->shape + (size_t)q * 4 * S;   /* wx, wy, dx, dy: particle_shape's layout */
 	idx_t i0 = 0, j0 = 0;
 	const double xi = (p->x[2 * q] - g->origin[0]) * g->inv_h;
 	const double eta = (p->x[2 * q + 1] - g->origin[1]) * g->inv_h;
-	if (evaluate_1d(kind, xi, g->cells[0], g->inv_h, &i0, wx, dx) ||
-	    evaluate_1d(kind, eta, g->cells[1], g->inv_h, &j0, wy, dy))
+	if (evaluate_1d(kind, xi, g->cells[0], g->inv_h, &i0, f, f + 2 * S) ||
+	    evaluate_1d(kind, eta, g->cells[1], g->inv_h, &j0, f + S, f + 3 * S))
 		return -1;
 	p->node0[q] = grid_node(g, i0, j0);
-	double *w = p->w + (size_t)q * S * S, *dw = p->dw + (size_t)q * 2 * S * S;
-#pragma GCC unroll 4
-	for (int b = 0; b < S; b++)
-#pragma GCC unroll 4
-		for (int a = 0; a < S; a++) {
-			const int k = a + b * S;
-			w[k] = wx[a] * wy[b];
-			dw[2 * k] = dx[a] * wy[b];
-			dw[2 * k + 1] = wx[a] * dy[b];
-		}
 	return 0;
 }
 

@@ -18,19 +18,20 @@
 			FOR_SUPPORT_OF((p)->support, g, p, q, __VA_ARGS__);          \
 	} while (0)
 
-/* FOR_SUPPORT on a support of S nodes per direction. */
+/* FOR_SUPPORT on a support of S nodes per direction: the weight and gradient are formed from the
+ * 1-D factors (particles.h), the same products the shape functions define. */
 #define FOR_SUPPORT_OF(S, g, p, q, ...)                                              \
 	do {                                                                         \
-		const int S_ = (S), nn_ = S_ * S_;                                   \
-		const double *w_ = (p)->w + (size_t)(q) * nn_;                       \
-		const double *dw_ = (p)->dw + (size_t)(q) * 2 * nn_;                 \
+		const int S_ = (S);                                                  \
+		const double *wx_ = (p)->shape + (size_t)(q) * 4 * S_;               \
+		const double *wy_ = wx_ + S_, *dx_ = wx_ + 2 * S_, *dy_ = wx_ + 3 * S_; \
 		const idx_t base_ = (p)->node0[q];                                   \
 		_Pragma("GCC unroll 4") for (int b_ = 0; b_ < S_; b_++)              \
 			_Pragma("GCC unroll 4") for (int a_ = 0; a_ < S_; a_++) {    \
-				const int k_ = a_ + b_ * S_;                         \
 				const idx_t I = base_ + a_ + b_ * (g)->nodes[0];     \
-				const double wk = w_[k_];                            \
-				const double gx = dw_[2 * k_], gy = dw_[2 * k_ + 1]; \
+				const double wk = wx_[a_] * wy_[b_];                 \
+				const double gx = dx_[a_] * wy_[b_];                 \
+				const double gy = wx_[a_] * dy_[b_];                 \
 				(void)wk, (void)gx, (void)gy;                        \
 				__VA_ARGS__                                          \
 			}                                                            \

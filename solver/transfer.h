@@ -2,8 +2,9 @@
  * transfer.h - particle-to-grid (P2G) and grid-to-particle (G2P) kernels shared by every scheme.
  *
  * Each kernel is one loop over the points of a set, using the shape cache filled by
- * shape_evaluate() (node0, w, dw). Scatters ADD into their nodal output (the caller zeroes it);
- * gathers OVERWRITE their per-point output. A NULL per-point weight or value array means 1.
+ * shape_evaluate() (node0 and the 1-D factors, particles.h). Scatters ADD into their nodal
+ * output (the caller zeroes it); gathers OVERWRITE their per-point output. A NULL per-point
+ * weight or value array means 1.
  *
  * Nodal vectors and per-point vectors are interleaved (x, y). Per-point 2x2 tensors are row-major
  * (xx, xy, yx, yy). Stresses are (xx, yy, xy, zz).

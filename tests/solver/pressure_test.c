@@ -27,16 +27,19 @@ static void dense_gradient(const struct sim *s, const struct particles *p, const
 {
 	const idx_t N = s->grid.node_count, nx = s->grid.nodes[0];
 	const int S = p->support, nn = S * S;
-	for (idx_t q = 0; q < p->n; q++)
+	for (idx_t q = 0; q < p->n; q++) {
+		const struct shape_factors f = particle_shape(p, q);
 		for (int k = 0; k < nn; k++) {
 			const idx_t I = p->node0[q] + k % S + (k / S) * nx;
+			const double S_I = f.wx[k % S] * f.wy[k / S];
 			for (int l = 0; l < nn; l++) {
 				const idx_t J = p->node0[q] + l % S + (l / S) * nx;
+				const double grad_S_J[2] = { f.dx[l % S] * f.wy[l / S], f.wx[l % S] * f.dy[l / S] };
 				for (int c = 0; c < 2; c++)
-					G[((size_t)I * N + J) * 2 + c] += V[q] * p->w[(size_t)q * nn + k] *
-									   p->dw[((size_t)q * nn + l) * 2 + c];
+					G[((size_t)I * N + J) * 2 + c] += V[q] * S_I * grad_S_J[c];
 			}
 		}
+	}
 }
 
 /* Largest differences of A and b from the brute-force assembly, relative to their largest entries. */

@@ -103,9 +103,11 @@ static void check_2d(enum case_shape kind, const char *label)
 	double worst = 0, worst_g = 0;
 	for (idx_t q = 0; q < p.n; q++) {
 		double s = 0, gx = 0, gy = 0;
+		const struct shape_factors f = particle_shape(&p, q);
 		for (int k = 0; k < nn; k++) {
-			s += p.w[q * nn + k];
-			gx += p.dw[2 * (q * nn + k)], gy += p.dw[2 * (q * nn + k) + 1];
+			const int a = k % S, b = k / S;
+			s += f.wx[a] * f.wy[b];
+			gx += f.dx[a] * f.wy[b], gy += f.wx[a] * f.dy[b];
 		}
 		worst = fmax(worst, fabs(s - 1));
 		worst_g = fmax(worst_g, fmax(fabs(gx), fabs(gy)) * g.h);
