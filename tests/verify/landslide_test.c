@@ -80,13 +80,13 @@ struct adjustment {
 	int weak_surface;   /* 1: formulation.free_surface "weak" instead of the case's */
 };
 
-static void adjust(struct case_spec *c, void *user)
+static void adjust(json_t *doc, void *user)
 {
 	const struct adjustment *a = user;
-	c->time.end = INITIALISATION + a->paper_end;
-	c->checkpoint.interval = 0;
+	slope_case_set(doc, "time", "end", json_real(INITIALISATION + a->paper_end));
+	json_object_del(doc, "checkpoint");
 	if (a->weak_surface)
-		c->formulation.free_surface = FREE_SURFACE_WEAK;
+		slope_case_set(doc, "formulation", "free_surface", json_string("weak"));
 }
 
 static struct landslide_run run_landslide(const char *file, double h, int ppc, double paper_end, int weak_surface)
