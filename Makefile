@@ -67,7 +67,7 @@ bench: deps
 	@$(MAKE) --no-print-directory build-all
 	@bash bench/run.sh $(BUILD)
 
-$(BUILD)/%.o: %.c $(wildcard solver/*.h tests/*.h common/*.h client/*.h server/*.h worker/*.h)
+$(BUILD)/%.o: %.c $(wildcard solver/*.h tests/*.h tests/verify/*.h common/*.h client/*.h server/*.h worker/*.h)
 	@mkdir -p $(dir $@)
 	$(CC) $(CPPFLAGS) -Icommon -Iclient $(CFLAGS) -c $< -o $@
 
