@@ -62,6 +62,7 @@ static const char *const projection_names[] = { "laplacian", "consistent", NULL 
 static const char *const pressure_stabilisation_names[] = { "none", "second_difference", NULL };
 static const char *const free_surface_names[] = { "nodes", "interpolated", "weak", NULL };
 static const char *const position_update_names[] = { "grid_velocity", "musl_displacement", NULL };
+static const char *const velocity_update_names[] = { "flip", "apic", NULL };
 static const char *const stabilisation_names[] = { "none", "fbar", "modified_fbar", "modified_fbar_cellwise",
 							   NULL };
 static const char *const permeability_law_names[] = { "constant", "kozeny_carman", "volume_ratio",
@@ -83,7 +84,7 @@ static const char *const formulation_keys[] = { "scheme", "phases", "shape", "po
 						"flip_fraction", "pressure_projection", "soil_stabilisation",
 						"drag_in_correction", "pressure_stabilisation",
 						"pressure_stabilisation_factor", "free_surface",
-						"free_surface_penalty_factor", "position_update", NULL };
+						"free_surface_penalty_factor", "position_update", "velocity_update", NULL };
 static const char *const grid_keys[] = { "origin", "extent", "cell_size", NULL };
 /* A material's own keys; its model's keys are checked by case_read_material_model(). */
 static const char *const material_keys[] = { "name", "density", NULL };
@@ -252,6 +253,11 @@ static void read_formulation(struct case_reader *r, const json_t *root, struct c
 	case_read_bool(r, o, p, "pore_pressure_smoothing", CASE_OPTIONAL, &f->pore_pressure_smoothing);
 	case_read_bool(r, o, p, "drag_in_correction", CASE_OPTIONAL, &f->drag_in_correction);
 	case_read_number(r, o, p, "flip_fraction", CASE_OPTIONAL, &FRACTION, &f->flip_fraction);
+	f->velocity_update = read_choice_or(r, o, p, "velocity_update", CASE_OPTIONAL, velocity_update_names,
+					    f->velocity_update);
+	if (f->velocity_update == VELOCITY_UPDATE_APIC && f->flip_fraction != 1)
+		case_problem(r, "/formulation/flip_fraction", "blends FLIP with PIC and has no meaning with "
+			     "/formulation/velocity_update \"apic\"");
 	f->pressure_projection = read_choice_or(r, o, p, "pressure_projection", CASE_OPTIONAL, projection_names,
 						f->pressure_projection);
 	f->soil_stabilisation = read_choice_or(r, o, p, "soil_stabilisation", CASE_OPTIONAL, stabilisation_names,
@@ -686,6 +692,7 @@ static void set_defaults(struct case_spec *c)
 	c->formulation.shape = SHAPE_QUADRATIC_BSPLINE;
 	c->formulation.pore_pressure_smoothing = 1;
 	c->formulation.flip_fraction = 1;
+	c->formulation.velocity_update = VELOCITY_UPDATE_FLIP;
 	c->formulation.drag_in_correction = 0;
 	c->formulation.pressure_stabilisation = PRESSURE_STABILISATION_NONE;
 	c->formulation.pressure_stabilisation_factor = DEFAULT_PRESSURE_STABILISATION_FACTOR;

@@ -13,7 +13,8 @@
 	X(stress, 4, skel) X(F, 4, skel) X(Be, 4, skel)            \
 	X(state, STATE_MAX, skel) X(plastic_strain, 1, skel)       \
 	X(dF, 4, skel) X(surface, 2, skel)                         \
-	X(shape, 4 * SHAPE_SUPPORT_MAX, !alias)
+	X(shape, 4 * SHAPE_SUPPORT_MAX, !alias)                    \
+	X(C, 4, 0) /* allocated on request: particles_add_affine */
 
 static enum poro_status allocate(struct particles *p, idx_t n, int skel, int alias, struct poro_error *err)
 {
@@ -65,6 +66,14 @@ enum poro_status particles_init_alias(struct particles *w, const struct particle
 	return PORO_OK;
 }
 
+enum poro_status particles_add_affine(struct particles *p, struct poro_error *err)
+{
+	if (!p->C && !(p->C = calloc((p->n > 0 ? (size_t)p->n : 1) * 4, sizeof(double))))
+		return poro_error_set(err, PORO_ENOMEM, "cannot allocate the affine velocities of %ld points",
+				      (long)p->n);
+	return PORO_OK;
+}
+
 void particles_remove(struct particles *p, idx_t q)
 {
 	idx_t last = p->n - 1;
@@ -88,7 +97,7 @@ void particles_release(struct particles *p)
 		free(p->porosity); free(p->porosity0); free(p->conductivity);
 		free(p->shape); free(p->body); free(p->node0);
 	}
-	free(p->v); free(p->mass); free(p->pressure);
+	free(p->v); free(p->C); free(p->mass); free(p->pressure);
 	free(p->stress); free(p->F); free(p->Be); free(p->state); free(p->plastic_strain);
 	free(p->dF); free(p->surface); free(p->surface_load);
 	memset(p, 0, sizeof *p);

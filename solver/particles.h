@@ -33,6 +33,8 @@ struct particles {
 	double *x;                  /* [2n] current position, m */
 	double *x0;                 /* [2n] initial position, m (displacement = x - x0) */
 	double *v;                  /* [2n] velocity, m/s */
+	double *C;                  /* [4n] APIC's affine velocity (xx, xy, yx, yy: dv_x/dx, dv_x/dy, ...),
+				       1/s; NULL unless formulation.velocity_update is "apic" */
 	double *mass;               /* [n] kg per m thickness; soil: (1-n0) rho_s V0 (Eq. 33), constant;
 				       water: n0 rho_w V0 (Eq. 37) in double point, constant */
 	double *volume;             /* [n] current volume V^t, m^3 per m */
@@ -84,6 +86,9 @@ enum poro_status particles_init(struct particles *p, idx_t n, int with_skeleton,
 /* Makes w a single-point water set riding on soil: shares x, x0, volume, volume0, porosity,
  * porosity0, body and the shape cache; owns v, mass, pressure. */
 enum poro_status particles_init_alias(struct particles *w, const struct particles *soil, struct poro_error *err);
+
+/* Gives p an affine velocity array C, zeroed (APIC, transfer.h). Returns PORO_ENOMEM on failure. */
+enum poro_status particles_add_affine(struct particles *p, struct poro_error *err);
 
 /* Removes point q by moving the last point into its place (order is not kept). Not for aliased
  * sets or sets with skeleton arrays. */

@@ -109,6 +109,15 @@ static void normalise(idx_t nodes, double *field, int width, const double *weigh
 }
 
 /* Step 2a-d: soil mass (Eq. 44), velocity (Eq. 45), porosity (Eq. 46), conductivity (Eq. 47). */
+/* out_I += sum_p S_Ip m_p v_p, with APIC's affine part when the case asks for it (transfer.h). */
+static void map_momentum(const struct sim *s, const struct particles *p, double *out)
+{
+	if (s->spec->formulation.velocity_update == VELOCITY_UPDATE_APIC)
+		p2g_affine_momentum(&s->grid, p, p->mass, p->v, p->C, out);
+	else
+		p2g_vector(&s->grid, p, p->mass, p->v, out);
+}
+
 static void map_soil_to_grid(struct sim *s)
 {
 	const struct particles *p = &s->soil;
@@ -117,7 +126,7 @@ static void map_soil_to_grid(struct sim *s)
 	s->mapped_mass_s = 0.0;
 	for (idx_t q = 0; q < p->n; q++)
 		s->mapped_mass_s += p->mass[q];
-	p2g_vector(&s->grid, p, p->mass, p->v, f->v_s);
+	map_momentum(s, p, f->v_s);
 	p2g_scalar(&s->grid, p, p->mass, p->porosity, f->porosity);
 	p2g_scalar(&s->grid, p, NULL, p->volume, f->volume_s);
 	p2g_scalar(&s->grid, p, p->mass, p->conductivity, f->conductivity);
@@ -159,7 +168,7 @@ static void map_water_to_grid(struct sim *s)
 	}
 	p2g_scalar(&s->grid, w, NULL, w->volume, f->mass_w_v);
 	p2g_scalar(&s->grid, w, NULL, w->mass, f->mass_w_points);
-	p2g_vector(&s->grid, w, w->mass, w->v, f->v_w);
+	map_momentum(s, w, f->v_w);
 	p2g_scalar(&s->grid, w, w->mass, w->pressure, f->pressure);
 	normalise(nodes, f->v_w, 2, f->mass_w_points);
 	normalise(nodes, f->pressure, 1, f->mass_w_points);
@@ -281,22 +290,28 @@ static void correct_velocities(struct sim *s)
 	boundary_apply(g, f->fix_s, f->v_s);
 }
 
-/* Step 7a-b for one set: FLIP velocity update blended with PIC by flip_fraction, and the
- * position update x += dt sum S v^{t+1}. v_old is overwritten with the nodal increment. */
+/* Step 7a-b for one set: the velocity update, FLIP blended with PIC by flip_fraction (000 §4.5)
+ * or APIC (transfer.h), and the position update x += dt sum S v^{t+1}. v_old is overwritten with
+ * the nodal increment. */
 static void move_points(struct sim *s, struct particles *p, const double *v_new, double *v_old,
 			double *scratch, int move_positions)
 {
-	const double alpha = s->spec->formulation.flip_fraction;
-	for (idx_t I = 0; I < 2 * s->grid.node_count; I++)
-		v_old[I] = v_new[I] - v_old[I];
 	double *v_pic = scratch, *dv = scratch + 2 * (size_t)p->n;
-	g2p_vector(&s->grid, p, v_new, v_pic);
-	g2p_vector(&s->grid, p, v_old, dv);
-	for (idx_t k = 0; k < 2 * p->n; k++) {
-		p->v[k] = alpha * (p->v[k] + dv[k]) + (1.0 - alpha) * v_pic[k];
-		if (move_positions)
-			p->x[k] += s->dt * v_pic[k];
+	if (s->spec->formulation.velocity_update == VELOCITY_UPDATE_APIC) {
+		g2p_affine_velocity(&s->grid, p, v_new, v_pic, p->C);
+		memcpy(p->v, v_pic, 2 * sizeof(double) * (size_t)p->n);
+	} else {
+		const double alpha = s->spec->formulation.flip_fraction;
+		for (idx_t I = 0; I < 2 * s->grid.node_count; I++)
+			v_old[I] = v_new[I] - v_old[I];
+		g2p_vector(&s->grid, p, v_new, v_pic);
+		g2p_vector(&s->grid, p, v_old, dv);
+		for (idx_t k = 0; k < 2 * p->n; k++)
+			p->v[k] = alpha * (p->v[k] + dv[k]) + (1.0 - alpha) * v_pic[k];
 	}
+	if (move_positions)
+		for (idx_t k = 0; k < 2 * p->n; k++)
+			p->x[k] += s->dt * v_pic[k];
 }
 
 /* 000 §5.4's initialisation with gravity.water_attached: the water points take the soil's nodal
@@ -305,7 +320,10 @@ static void move_points(struct sim *s, struct particles *p, const double *v_new,
 static void attach_water_to_soil(struct sim *s)
 {
 	struct particles *w = &s->water;
-	g2p_vector(&s->grid, w, s->f.v_s, w->v);
+	if (s->spec->formulation.velocity_update == VELOCITY_UPDATE_APIC)
+		g2p_affine_velocity(&s->grid, w, s->f.v_s, w->v, w->C);
+	else
+		g2p_vector(&s->grid, w, s->f.v_s, w->v);
 	if (s->double_point)
 		for (idx_t k = 0; k < 2 * w->n; k++)
 			w->x[k] += s->dt * w->v[k];
@@ -492,7 +510,7 @@ static enum poro_status update_soil_kinematics(struct sim *s)
 {
 	struct particles *p = &s->soil;
 	struct grid_fields *f = &s->f;
-	p2g_vector(&s->grid, p, p->mass, p->v, f->du_s);
+	map_momentum(s, p, f->du_s);
 	for (idx_t I = 0; I < s->grid.node_count; I++)
 		for (int c = 0; c < 2; c++)
 			f->du_s[2 * I + c] = f->mass_s[I] > 0.0 ? s->dt * f->du_s[2 * I + c] / f->mass_s[I] : 0.0;

@@ -171,6 +171,9 @@ static enum poro_status build(struct sim *s)
 	init_soil_state(s);
 	if ((st = init_water(s)) || (st = allocate_scratch(s)))
 		return st;
+	if (c->formulation.velocity_update == VELOCITY_UPDATE_APIC &&
+	    ((st = particles_add_affine(&s->soil, &s->err)) || (st = particles_add_affine(&s->water, &s->err))))
+		return st;
 	stabilisation_patches_init(s);
 	if ((st = pressure_system_init(&s->ps, &s->grid, s->soil.support, c->formulation.pressure_projection,
 				       c->formulation.free_surface != FREE_SURFACE_NODES, &s->err)))

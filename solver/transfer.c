@@ -141,3 +141,71 @@ void g2p_divergence(const struct grid *g, const struct particles *p, const doubl
 		out[q] = s;
 	}
 }
+
+/* The offsets X_a - x_p (in metres) of a point's support nodes along one direction, x_p being
+ * sum_a w_a X_a: the first moment of the 1-D weights (transfer.h, APIC), and D = sum_a w_a d_a^2.
+ * Relative to the first support node, so no large coordinates cancel. */
+static inline double support_offsets(const double *w, int S, double h, double *d)
+{
+	double first_moment = 0.0;
+	for (int a = 0; a < S; a++)
+		first_moment += w[a] * a;
+	double D = 0.0;
+	for (int a = 0; a < S; a++) {
+		d[a] = (a - first_moment) * h;
+		D += w[a] * d[a] * d[a];
+	}
+	return D;
+}
+
+#define AFFINE_D_FLOOR 1e-12   /* of h^2: below it a direction has no affine part (transfer.h) */
+
+void p2g_affine_momentum(const struct grid *g, const struct particles *p, const double *mass, const double *v,
+			 const double *C, double *out)
+{
+	const int S = p->support;
+	const idx_t nx = g->nodes[0];
+	for (idx_t q = 0; q < p->n; q++) {
+		const struct shape_factors f = particle_shape(p, q);
+		double dX[SHAPE_SUPPORT_MAX], dY[SHAPE_SUPPORT_MAX];
+		support_offsets(f.wx, S, g->h, dX);
+		support_offsets(f.wy, S, g->h, dY);
+		const double m = mass[q], *Cq = C + 4 * q;
+		for (int b = 0; b < S; b++)
+			for (int a = 0; a < S; a++) {
+				const idx_t I = p->node0[q] + a + b * nx;
+				const double mS = m * (f.wx[a] * f.wy[b]);
+				out[2 * I] += mS * (v[2 * q] + Cq[0] * dX[a] + Cq[1] * dY[b]);
+				out[2 * I + 1] += mS * (v[2 * q + 1] + Cq[2] * dX[a] + Cq[3] * dY[b]);
+			}
+	}
+}
+
+void g2p_affine_velocity(const struct grid *g, const struct particles *p, const double *node, double *v,
+			 double *C)
+{
+	const int S = p->support;
+	const idx_t nx = g->nodes[0];
+	const double floor = AFFINE_D_FLOOR * g->h * g->h;
+#pragma omp parallel for schedule(static)
+	for (idx_t q = 0; q < p->n; q++) {
+		const struct shape_factors f = particle_shape(p, q);
+		double dX[SHAPE_SUPPORT_MAX], dY[SHAPE_SUPPORT_MAX];
+		const double Dxx = support_offsets(f.wx, S, g->h, dX), Dyy = support_offsets(f.wy, S, g->h, dY);
+		double vx = 0, vy = 0, Bxx = 0, Bxy = 0, Byx = 0, Byy = 0;   /* B = sum S v (x_I - x_p)^T */
+		for (int b = 0; b < S; b++)
+			for (int a = 0; a < S; a++) {
+				const idx_t I = p->node0[q] + a + b * nx;
+				const double wk = f.wx[a] * f.wy[b], ux = wk * node[2 * I], uy = wk * node[2 * I + 1];
+				vx += ux, vy += uy;
+				Bxx += ux * dX[a], Bxy += ux * dY[b];
+				Byx += uy * dX[a], Byy += uy * dY[b];
+			}
+		v[2 * q] = vx, v[2 * q + 1] = vy;
+		double *Cq = C + 4 * q;
+		Cq[0] = Dxx > floor ? Bxx / Dxx : 0.0;
+		Cq[1] = Dyy > floor ? Bxy / Dyy : 0.0;
+		Cq[2] = Dxx > floor ? Byx / Dxx : 0.0;
+		Cq[3] = Dyy > floor ? Byy / Dyy : 0.0;
+	}
+}

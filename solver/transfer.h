@@ -43,4 +43,21 @@ void g2p_vector_gradient(const struct grid *g, const struct particles *p, const 
 /* out_p = div of a nodal 2-vector at each point. */
 void g2p_divergence(const struct grid *g, const struct particles *p, const double *node, double *out);
 
+/* APIC, the affine particle-in-cell transfer (Jiang, Schroeder, Selle, Teran and Stomakhin 2015):
+ * each point carries a velocity v_p and an affine velocity C_p (4 per point, row-major), and
+ *     P2G  out_I += sum_p S_Ip m_p (v_p + C_p (x_I - x_p))
+ *     G2P  v_p = sum_I S_Ip v_I,   C_p = sum_I S_Ip v_I (x_I - x_p)^T D_p^-1,
+ *          D_p = sum_I S_Ip (x_I - x_p)(x_I - x_p)^T.
+ * A nodal field that is affine near the point comes back exactly, and linear and angular
+ * momentum survive the round trip, while the velocity the grid cannot represent is dropped, as
+ * in PIC (FLIP keeps it; docs/numerics.md, "Point velocities"). x_p is the position the shape
+ * cache was evaluated at, sum_I S_Ip x_I (the shapes reproduce linear fields), so the pair is
+ * consistent with the cache however far the points have moved since. For the tensor-product
+ * shapes D_p is diagonal: D_xx = sum_a wx_a (X_a - x_p)^2. A direction in which D_p vanishes (a
+ * point on an edge node, where the edge-modified basis has one node) gives no affine part. */
+void p2g_affine_momentum(const struct grid *g, const struct particles *p, const double *mass, const double *v,
+			 const double *C, double *out);
+void g2p_affine_velocity(const struct grid *g, const struct particles *p, const double *node, double *v,
+			 double *C);
+
 #endif

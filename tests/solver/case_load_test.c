@@ -186,6 +186,7 @@ static void test_minimal_defaults(const struct case_spec *c)
 	      "kind %d factor %g", f->free_surface, f->free_surface_penalty_factor);
 	CHECK(f->position_update == POSITION_UPDATE_GRID_VELOCITY, "default position update", "got %d",
 	      f->position_update);
+	CHECK(f->velocity_update == VELOCITY_UPDATE_FLIP, "default velocity update", "got %d", f->velocity_update);
 	CHECK(c->bodies[0].permeability_law == PERMEABILITY_CONSTANT, "default permeability law", "got %d",
 	      c->bodies[0].permeability_law);
 	CHECK(c->fluid.density == 1000 && c->fluid.bulk_modulus == 2.2e9, "default fluid",
@@ -407,6 +408,21 @@ static void test_out_of_range(void)
 		struct case_spec *c = load_valid("position update by the MUSL displacement", text);
 		CHECK(c && c->formulation.position_update == POSITION_UPDATE_MUSL_DISPLACEMENT, "position update read",
 		      "got %d", c ? (int)c->formulation.position_update : -1);
+		case_destroy(&c);
+		free(text);
+	}
+	expect_invalid("unknown velocity update", "/formulation/velocity_update", "\"mls\"",
+		       "/formulation/velocity_update: must be one of 'flip', 'apic', got 'mls'");
+	expect_invalid("apic with a flip fraction", "/formulation/velocity_update", "\"apic\"",
+		       "/formulation/flip_fraction: blends FLIP with PIC and has no meaning with "
+		       "/formulation/velocity_update \"apic\"");
+	{
+		const struct edit e[] = { { "/formulation/velocity_update", "\"apic\"" },
+					  { "/formulation/flip_fraction", "1" } };
+		char *text = edited(full_case, e, 2);
+		struct case_spec *c = load_valid("velocity update by APIC", text);
+		CHECK(c && c->formulation.velocity_update == VELOCITY_UPDATE_APIC, "velocity update read", "got %d",
+		      c ? (int)c->formulation.velocity_update : -1);
 		case_destroy(&c);
 		free(text);
 	}

@@ -10,7 +10,8 @@
  * relative to the field's largest magnitude. Not bit for bit: the first pressure solve after a
  * resume factorises afresh where the uninterrupted run uses conjugate gradients on its previous
  * factor (spd_solve.h), converged to a relative residual of 1e-12; the measured differences are
- * printed as INFO lines. Both double point and single point.
+ * printed as INFO lines. Both double point and single point, each also with APIC point velocities
+ * (whose affine velocities C the checkpoint must carry).
  *
  * The sim_run test kills a run in a child process (_exit, like kill -9) right after its first
  * checkpoint is announced, resumes it in the same directory, and requires result.h5 to hold the
@@ -36,10 +37,12 @@
 #define FIELD_FLOOR 1e-300        /* a field that is zero everywhere compares absolutely */
 
 /* A 0.1 m x 0.3 m column of 0.25 m, 160 soil points, Hencky skeleton, loaded on a ramp, drained
- * on top. %s: phases; %s: an extra top-level member (the checkpoint interval for sim_run). */
+ * on top. %s: phases; %s: the velocity update; %s: an extra top-level member (the checkpoint
+ * interval for sim_run). */
 static const char case_format[] =
 	"{\"schema\": \"poro-case/1\", \"title\": \"checkpoint test column\","
-	" \"formulation\": {\"scheme\": \"semi_implicit\", \"phases\": \"%s\", \"shape\": \"quadratic_bspline\"},"
+	" \"formulation\": {\"scheme\": \"semi_implicit\", \"phases\": \"%s\", \"velocity_update\": \"%s\","
+	"   \"shape\": \"quadratic_bspline\"},"
 	" \"grid\": {\"origin\": [0.0, 0.0], \"extent\": [0.1, 0.3], \"cell_size\": 0.025},"
 	" \"materials\": [{\"name\": \"silt\", \"model\": \"hencky\", \"density\": 2683,"
 	"   \"youngs_modulus\": 1.37e6, \"poisson_ratio\": 0.23}],"
@@ -59,13 +62,18 @@ static const char case_format[] =
 	"   {\"name\": \"syy_mid\", \"kind\": \"average\", \"field\": \"stress_yy\","
 	"    \"box\": {\"min\": [0.0, 0.1], \"max\": [0.1, 0.15]}}]%s}";
 
-static char *case_json(const char *phases, const char *extra)
+static char *case_json_with(const char *phases, const char *velocity_update, const char *extra)
 {
 	static char buf[4][4096];
 	static int next;
 	char *b = buf[next++ % 4];
-	snprintf(b, sizeof buf[0], case_format, phases, DT, (STEPS_BEFORE + STEPS_AFTER) * DT, extra);
+	snprintf(b, sizeof buf[0], case_format, phases, velocity_update, DT, (STEPS_BEFORE + STEPS_AFTER) * DT, extra);
 	return b;
+}
+
+static char *case_json(const char *phases, const char *extra)
+{
+	return case_json_with(phases, "flip", extra);
 }
 
 /* ---- fixtures ---------------------------------------------------------------------------------- */
@@ -147,6 +155,10 @@ static int identical(const struct sim *a, const struct sim *b)
 			      &worst, &name) == 0 && worst == 0.0;
 	ok = ok && compare_sets(sim_water(a), sim_water(b), water_fields, sizeof water_fields / sizeof water_fields[0],
 				&worst, &name) == 0 && worst == 0.0;
+	for (int set = 0; ok && set < 2; set++) {   /* APIC's affine velocities, where the run has them */
+		const struct particles *pa = set ? sim_water(a) : sim_soil(a), *pb = set ? sim_water(b) : sim_soil(b);
+		ok = !pa->C == !pb->C && (!pa->C || memcmp(pa->C, pb->C, sizeof(double) * 4 * (size_t)pa->n) == 0);
+	}
 	ok = ok && memcmp(sim_soil(a)->body, sim_soil(b)->body, sizeof(int) * (size_t)sim_soil(a)->n) == 0 &&
 	     memcmp(sim_soil(a)->surface_load, sim_soil(b)->surface_load, sizeof(int) * (size_t)sim_soil(a)->n) == 0;
 	ok = ok && sim_steps_taken(a) == sim_steps_taken(b) && sim_time(a) == sim_time(b) &&
@@ -160,27 +172,27 @@ static int identical(const struct sim *a, const struct sim *b)
 
 /* ---- step-level resume ------------------------------------------------------------------------- */
 
-static void test_resume(const char *phases)
+static void test_resume(const char *label, const char *phases, const char *velocity_update)
 {
 	char name[128], path[128];
 	struct case_spec *ca = NULL, *cb = NULL;
-	const char *json = case_json(phases, "");
+	const char *json = case_json_with(phases, velocity_update, "");
 	char *dir = harness_temp_dir("checkpoint_test");
 	struct sim *a = new_sim(json, &ca), *b = new_sim(json, &cb);
-	snprintf(name, sizeof name, "%s_builds", phases);
+	snprintf(name, sizeof name, "%s_builds", label);
 	CHECK(dir && a && b, name, "no directory or simulation");
 	if (!dir || !a || !b)
 		goto out;
 
 	int ok = steps(a, STEPS_BEFORE) == 0 && checkpoint_write(a, dir) == PORO_OK;
-	snprintf(name, sizeof name, "%s_checkpoint_written", phases);
+	snprintf(name, sizeof name, "%s_checkpoint_written", label);
 	struct stat sb;
 	CHECK(ok && stat(harness_join(path, sizeof path, dir, CHECKPOINT_NAME), &sb) == 0 &&
 	      stat(harness_join(path, sizeof path, dir, CHECKPOINT_TMP_NAME), &sb) != 0, name, "%s",
 	      ok ? "checkpoint.h5 missing or checkpoint.h5.tmp left" : sim_error(a)->message);
 
 	enum poro_status st = checkpoint_load(b, harness_join(path, sizeof path, dir, CHECKPOINT_NAME));
-	snprintf(name, sizeof name, "%s_load_restores_exact_state", phases);
+	snprintf(name, sizeof name, "%s_load_restores_exact_state", label);
 	CHECK(!st && checkpoint_resumed(b) && identical(a, b), name, "status %d: %s", st, sim_error(b)->message);
 
 	ok = steps(a, STEPS_AFTER) == 0 && steps(b, STEPS_AFTER) == 0 && sim_done(a) && sim_done(b);
@@ -190,9 +202,9 @@ static void test_resume(const char *phases)
 				 &worst, &worst_name);
 	sizes |= compare_sets(sim_water(b), sim_water(a), water_fields, sizeof water_fields / sizeof water_fields[0],
 			      &worst, &worst_name);
-	printf("INFO %s: after %d steps from the checkpoint, largest relative difference %.3g (%s)\n", phases,
+	printf("INFO %s: after %d steps from the checkpoint, largest relative difference %.3g (%s)\n", label,
 	       STEPS_AFTER, worst, worst_name);
-	snprintf(name, sizeof name, "%s_resumed_run_matches_uninterrupted", phases);
+	snprintf(name, sizeof name, "%s_resumed_run_matches_uninterrupted", label);
 	CHECK(ok && sizes == 0 && worst <= RESUME_TOLERANCE && sim_time(a) == sim_time(b), name,
 	      "steps ok %d, sizes %d, worst %.3g in %s", ok, sizes, worst, worst_name);
 out:
@@ -489,8 +501,10 @@ int main(int argc, char **argv)
 {
 	if (argc == 4 && !strcmp(argv[1], CHILD_FLAG))
 		return run_until_checkpoint(argv[2], argv[3]);
-	test_resume("double_point");
-	test_resume("single_point");
+	test_resume("double_point", "double_point", "flip");
+	test_resume("single_point", "single_point", "flip");
+	test_resume("double_point_apic", "double_point", "apic");
+	test_resume("single_point_apic", "single_point", "apic");
 	test_refusals();
 	test_run_killed_and_resumed("double_point");
 	test_run_killed_and_resumed("single_point");
