@@ -108,8 +108,9 @@ static void normalise(idx_t nodes, double *field, int width, const double *weigh
 			field[width * I + c] = weight[I] > 0.0 ? field[width * I + c] / weight[I] : 0.0;
 }
 
-/* Step 2a-d: soil mass (Eq. 44), velocity (Eq. 45), porosity (Eq. 46), conductivity (Eq. 47). */
-/* out_I += sum_p S_Ip m_p v_p, with APIC's affine part when the case asks for it (transfer.h). */
+/* The point velocities' two transfers, with APIC's affine part when the case asks for it
+ * (transfer.h): map_momentum adds out_I += sum_p S_Ip m_p v_p; gather_velocity sets
+ * v_p = sum_I S_Ip node_I (PIC) and, with APIC, the points' affine velocities C_p. */
 static void map_momentum(const struct sim *s, const struct particles *p, double *out)
 {
 	if (s->spec->formulation.velocity_update == VELOCITY_UPDATE_APIC)
@@ -118,6 +119,15 @@ static void map_momentum(const struct sim *s, const struct particles *p, double 
 		p2g_vector(&s->grid, p, p->mass, p->v, out);
 }
 
+static void gather_velocity(const struct sim *s, struct particles *p, const double *node, double *v)
+{
+	if (s->spec->formulation.velocity_update == VELOCITY_UPDATE_APIC)
+		g2p_affine_velocity(&s->grid, p, node, v, p->C);
+	else
+		g2p_vector(&s->grid, p, node, v);
+}
+
+/* Step 2a-d: soil mass (Eq. 44), velocity (Eq. 45), porosity (Eq. 46), conductivity (Eq. 47). */
 static void map_soil_to_grid(struct sim *s)
 {
 	const struct particles *p = &s->soil;
@@ -298,8 +308,8 @@ static void move_points(struct sim *s, struct particles *p, const double *v_new,
 {
 	double *v_pic = scratch, *dv = scratch + 2 * (size_t)p->n;
 	if (s->spec->formulation.velocity_update == VELOCITY_UPDATE_APIC) {
-		g2p_affine_velocity(&s->grid, p, v_new, v_pic, p->C);
-		memcpy(p->v, v_pic, 2 * sizeof(double) * (size_t)p->n);
+		v_pic = p->v;   /* APIC's point velocity is the PIC one */
+		gather_velocity(s, p, v_new, p->v);
 	} else {
 		const double alpha = s->spec->formulation.flip_fraction;
 		for (idx_t I = 0; I < 2 * s->grid.node_count; I++)
@@ -320,10 +330,7 @@ static void move_points(struct sim *s, struct particles *p, const double *v_new,
 static void attach_water_to_soil(struct sim *s)
 {
 	struct particles *w = &s->water;
-	if (s->spec->formulation.velocity_update == VELOCITY_UPDATE_APIC)
-		g2p_affine_velocity(&s->grid, w, s->f.v_s, w->v, w->C);
-	else
-		g2p_vector(&s->grid, w, s->f.v_s, w->v);
+	gather_velocity(s, w, s->f.v_s, w->v);
 	if (s->double_point)
 		for (idx_t k = 0; k < 2 * w->n; k++)
 			w->x[k] += s->dt * w->v[k];
