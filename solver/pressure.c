@@ -93,53 +93,89 @@ void pressure_system_release(struct pressure_system *ps)
 	memset(ps, 0, sizeof *ps);
 }
 
+/* A point's shape-function gradients over its support, grad S_Jp = (dx wy, wx dy) for J = lx + ly S,
+ * formed once per point: the stencil loops below then read them from registers rather than
+ * re-forming them for every row I (the compiler cannot hoist the products itself, since the
+ * stencil stores might alias the shape cache). The products are the same, so are the sums. */
+static inline void support_gradients(const struct shape_factors f, const int S, double *gx, double *gy)
+{
+	for (int ly = 0; ly < S; ly++)
+		for (int lx = 0; lx < S; lx++) {
+			gx[lx + ly * S] = f.dx[lx] * f.wy[ly];
+			gy[lx + ly * S] = f.wx[lx] * f.dy[ly];
+		}
+}
+
+/* Point q's terms of Eq. 61, c_q grad S_Iq . grad S_Jq, for a support of S nodes per direction;
+ * called with S constant so that the quadratic B-spline's copy is unrolled. */
+static inline void add_point_laplacian(struct pressure_system *ps, idx_t nx, const struct particles *p, idx_t q,
+				       double c, const int S)
+{
+	const int W = ps->width, R = ps->radius;
+	const struct shape_factors f = particle_shape(p, q);
+	double gxJ[SHAPE_NODES_MAX], gyJ[SHAPE_NODES_MAX];
+	support_gradients(f, S, gxJ, gyJ);
+	for (int ky = 0; ky < S; ky++)
+		for (int kx = 0; kx < S; kx++) {
+			const idx_t I = p->node0[q] + kx + ky * nx;
+			double *row = ps->stencil + (size_t)I * W * W;
+			const double gx = c * gxJ[kx + ky * S], gy = c * gyJ[kx + ky * S];
+			for (int ly = 0; ly < S; ly++) {   /* one grid line of J: adjacent entries */
+				double *dst = row + (R - kx) + (ly - ky + R) * W;
+				for (int lx = 0; lx < S; lx++)
+					dst[lx] += gx * gxJ[lx + ly * S] + gy * gyJ[lx + ly * S];
+			}
+		}
+}
+
 /* Adds sum_p coef_p grad S_Ip . grad S_Jp into the stencil (Eq. 61). */
 static void assemble_laplacian(struct sim *s, const struct particles *p, const double *coef)
 {
-	const struct grid *g = &s->grid;
-	struct pressure_system *ps = &s->ps;
-	const int S = p->support, W = ps->width, R = ps->radius;
+	const idx_t nx = s->grid.nodes[0];
 	for (idx_t q = 0; q < p->n; q++) {
-		const struct shape_factors f = particle_shape(p, q);   /* grad S = (dx wy, wx dy) */
-		const double c = coef[q];
-		for (int ky = 0; ky < S; ky++)
-			for (int kx = 0; kx < S; kx++) {
-				const idx_t I = p->node0[q] + kx + ky * g->nodes[0];
-				double *row = ps->stencil + (size_t)I * W * W;
-				const double gx = c * (f.dx[kx] * f.wy[ky]), gy = c * (f.wx[kx] * f.dy[ky]);
-				for (int ly = 0; ly < S; ly++) {   /* one grid line of J: adjacent entries */
-					double *dst = row + (R - kx) + (ly - ky + R) * W;
-					for (int lx = 0; lx < S; lx++)
-						dst[lx] += gx * (f.dx[lx] * f.wy[ly]) + gy * (f.wx[lx] * f.dy[ly]);
+		if (p->support == 3)
+			add_point_laplacian(&s->ps, nx, p, q, coef[q], 3);
+		else
+			add_point_laplacian(&s->ps, nx, p, q, coef[q], p->support);
+	}
+}
+
+/* Point q's terms of G_IJ = sum_p V_p S_Ip grad S_Jp (before the nodal porosity factor), for a
+ * support of S nodes per direction (constant in the unrolled copy, as above). */
+static inline void add_point_gradient(const struct pressure_system *ps, idx_t nx, const struct particles *p,
+				      idx_t q, double *G, const int S)
+{
+	const int W = ps->g_width, R = ps->g_radius;
+	const struct shape_factors f = particle_shape(p, q);
+	double gxJ[SHAPE_NODES_MAX], gyJ[SHAPE_NODES_MAX];
+	support_gradients(f, S, gxJ, gyJ);
+	const double V = p->volume[q];
+	for (int ky = 0; ky < S; ky++)
+		for (int kx = 0; kx < S; kx++) {
+			const idx_t I = p->node0[q] + kx + ky * nx;
+			double *row = G + (size_t)I * W * W * 2;
+			const double vs = V * (f.wx[kx] * f.wy[ky]);
+			/* the support nodes J of one grid line are adjacent in the row: 2 S
+			 * contiguous entries per line */
+			for (int ly = 0; ly < S; ly++) {
+				double *dst = row + 2 * ((R - kx) + (ly - ky + R) * W);
+				for (int lx = 0; lx < S; lx++) {
+					dst[2 * lx] += vs * gxJ[lx + ly * S];
+					dst[2 * lx + 1] += vs * gyJ[lx + ly * S];
 				}
 			}
-	}
+		}
 }
 
 /* G_IJ = f_I sum_p V_p S_Ip grad S_Jp for one set (Eqs. 67-68 before the nodal porosity factor). */
 static void add_gradient_operator(const struct sim *s, const struct particles *p, double *G)
 {
-	const struct grid *g = &s->grid;
-	const struct pressure_system *ps = &s->ps;
-	const int S = p->support, W = ps->g_width, R = ps->g_radius;
+	const idx_t nx = s->grid.nodes[0];
 	for (idx_t q = 0; q < p->n; q++) {
-		const struct shape_factors f = particle_shape(p, q);   /* S = wx wy, grad S = (dx wy, wx dy) */
-		const double V = p->volume[q];
-		for (int ky = 0; ky < S; ky++)
-			for (int kx = 0; kx < S; kx++) {
-				const idx_t I = p->node0[q] + kx + ky * g->nodes[0];
-				double *row = G + (size_t)I * W * W * 2;
-				const double vs = V * (f.wx[kx] * f.wy[ky]);
-				/* the support nodes J of one grid line are adjacent in the row: 2 S
-				 * contiguous entries per line */
-				for (int ly = 0; ly < S; ly++) {
-					double *dst = row + 2 * ((R - kx) + (ly - ky + R) * W);
-					for (int lx = 0; lx < S; lx++) {
-						dst[2 * lx] += vs * (f.dx[lx] * f.wy[ly]);
-						dst[2 * lx + 1] += vs * (f.wx[lx] * f.dy[ly]);
-					}
-				}
-			}
+		if (p->support == 3)
+			add_point_gradient(&s->ps, nx, p, q, G, 3);
+		else
+			add_point_gradient(&s->ps, nx, p, q, G, p->support);
 	}
 }
 
@@ -303,14 +339,11 @@ static void assemble_rhs(struct sim *s)
 {
 	struct grid_fields *f = &s->f;
 	const struct grid *g = &s->grid;
-	double *div_s = s->soil_scalar, *div_w = s->water_scalar;
 	double *sum_s = f->correction_s, *sum_w = f->correction_w;   /* free until step 6 */
 	memset(sum_s, 0, sizeof(double) * (size_t)g->node_count);
 	memset(sum_w, 0, sizeof(double) * (size_t)g->node_count);
-	g2p_divergence(g, &s->soil, f->v_s_star, div_s);
-	p2g_scalar(g, &s->soil, s->soil.volume, div_s, sum_s);
-	g2p_divergence(g, &s->water, f->v_w_star, div_w);
-	p2g_scalar(g, &s->water, s->water.volume, div_w, sum_w);
+	p2g_point_divergence(g, &s->soil, s->soil.volume, f->v_s_star, sum_s);
+	p2g_point_divergence(g, &s->water, s->water.volume, f->v_w_star, sum_w);
 	for (idx_t I = 0; I < g->node_count; I++)
 		f->rhs[I] = ((1.0 - f->porosity[I]) * sum_s[I] + f->porosity[I] * sum_w[I]) / s->dt;
 	memset(sum_s, 0, sizeof(double) * (size_t)g->node_count);

@@ -132,14 +132,19 @@ static void map_soil_to_grid(struct sim *s)
 {
 	const struct particles *p = &s->soil;
 	struct grid_fields *f = &s->f;
-	p2g_scalar(&s->grid, p, NULL, p->mass, f->mass_s);
+	const int apic = s->spec->formulation.velocity_update == VELOCITY_UPDATE_APIC;
+	const struct p2g_batch b = {
+		.scalars = 4,
+		.scalar = {{NULL, p->mass, f->mass_s}, {p->mass, p->porosity, f->porosity},
+			   {NULL, p->volume, f->volume_s}, {p->mass, p->conductivity, f->conductivity}},
+		.vector = {p->mass, p->v, apic ? NULL : f->v_s},   /* APIC's momentum: map_momentum */
+	};
+	p2g_batch(&s->grid, p, &b);
+	if (apic)
+		map_momentum(s, p, f->v_s);
 	s->mapped_mass_s = 0.0;
 	for (idx_t q = 0; q < p->n; q++)
 		s->mapped_mass_s += p->mass[q];
-	map_momentum(s, p, f->v_s);
-	p2g_scalar(&s->grid, p, p->mass, p->porosity, f->porosity);
-	p2g_scalar(&s->grid, p, NULL, p->volume, f->volume_s);
-	p2g_scalar(&s->grid, p, p->mass, p->conductivity, f->conductivity);
 	idx_t nodes = s->grid.node_count;
 	normalise(nodes, f->v_s, 2, f->mass_s);
 	normalise(nodes, f->conductivity, 1, f->mass_s);
@@ -152,34 +157,36 @@ static void map_soil_to_grid(struct sim *s)
 	memcpy(f->v_s_old, f->v_s, 2 * sizeof(double) * (size_t)nodes);
 }
 
-/* Steps 8h-8i, done at the start of the step from the nodal porosity just mapped: the soil
- * porosity seen by each water point (Eq. 48) and its volume V_wp = n0 / n V0 (Eq. 36). Double
- * point only: single-point water shares the soil points' porosity and volume. */
-static void project_porosity_to_water(struct sim *s)
-{
-	struct particles *w = &s->water;
-	if (!s->double_point)
-		return;
-	g2p_scalar(&s->grid, w, s->f.porosity, w->porosity);
-	for (idx_t q = 0; q < w->n; q++)
-		w->volume[q] = w->porosity0[q] / w->porosity[q] * w->volume0[q];
-}
-
-/* Step 2e-f: water mass (Eq. 50), water velocity (Eq. 51) and the nodal pressure p^t. */
+/* Step 2e-f: water mass (Eq. 50), water velocity (Eq. 51) and the nodal pressure p^t, in one
+ * loop over the water points. Double point first takes steps 8h-8i of the last step at each
+ * point, from the nodal porosity just mapped (so they use the points' current positions): the
+ * soil porosity seen by the water point (Eq. 48) and its volume V_wp = n0 / n V0 (Eq. 36).
+ * Single-point water shares the soil points' porosity and volume. */
 static void map_water_to_grid(struct sim *s)
 {
 	struct particles *w = &s->water;
 	struct grid_fields *f = &s->f;
 	const idx_t nodes = s->grid.node_count;
+	const int apic = s->spec->formulation.velocity_update == VELOCITY_UPDATE_APIC;
+	const struct p2g_batch b = {
+		.scalars = 3,
+		.scalar = {{NULL, w->volume, f->mass_w_v}, {NULL, w->mass, f->mass_w_points},
+			   {w->mass, w->pressure, f->pressure}},
+		.vector = {w->mass, w->v, apic ? NULL : f->v_w},   /* APIC's momentum: map_momentum */
+	};
 	s->mapped_mass_w = 0.0;
-	for (idx_t q = 0; q < w->n; q++) {  /* n rho_w V: constant n0 rho_w V0 in double point (Eq. 37) */
+	for (idx_t q = 0; q < w->n; q++) {
+		if (s->double_point) {
+			w->porosity[q] = g2p_scalar_point(&s->grid, w, q, f->porosity);
+			w->volume[q] = w->porosity0[q] / w->porosity[q] * w->volume0[q];
+		}
+		/* n rho_w V: constant n0 rho_w V0 in double point (Eq. 37) */
 		w->mass[q] = w->porosity[q] * s->rho_w * w->volume[q];
 		s->mapped_mass_w += w->mass[q];
+		p2g_batch_point(&s->grid, w, q, &b);
 	}
-	p2g_scalar(&s->grid, w, NULL, w->volume, f->mass_w_v);
-	p2g_scalar(&s->grid, w, NULL, w->mass, f->mass_w_points);
-	map_momentum(s, w, f->v_w);
-	p2g_scalar(&s->grid, w, w->mass, w->pressure, f->pressure);
+	if (apic)
+		map_momentum(s, w, f->v_w);
 	normalise(nodes, f->v_w, 2, f->mass_w_points);
 	normalise(nodes, f->pressure, 1, f->mass_w_points);
 	for (idx_t I = 0; I < nodes; I++)   /* Eq. 50: grid porosity times sum S rho_w V_wp */
@@ -268,7 +275,6 @@ static void correct_velocities(struct sim *s)
 {
 	struct grid_fields *f = &s->f;
 	const struct grid *g = &s->grid;
-	double *grad_s = s->soil_grad, *grad_w = s->water_vec;
 	const int drag = s->spec->formulation.drag_in_correction;
 	/* with the weak free-surface condition G carries the surface's push (free_surface.c), which
 	 * a sum over the points cannot rebuild; G also carries the nodal porosity factors */
@@ -279,10 +285,8 @@ static void correct_velocities(struct sim *s)
 		pressure_apply_gradient(s, s->ps.grad_s, f->dp, f->correction_s);
 		pressure_apply_gradient(s, s->ps.grad_w, f->dp, f->correction_w);
 	} else {
-		g2p_scalar_gradient(g, &s->soil, f->dp, grad_s);
-		p2g_vector(g, &s->soil, s->soil.volume, grad_s, f->correction_s);
-		g2p_scalar_gradient(g, &s->water, f->dp, grad_w);
-		p2g_vector(g, &s->water, s->water.volume, grad_w, f->correction_w);
+		p2g_point_gradient(g, &s->soil, s->soil.volume, f->dp, f->correction_s);
+		p2g_point_gradient(g, &s->water, s->water.volume, f->dp, f->correction_w);
 	}
 	for (idx_t I = 0; I < g->node_count; I++) {
 		const double n = f->porosity[I], share_s = weak ? 1.0 : 1.0 - n, share_w = weak ? 1.0 : n;
@@ -303,25 +307,18 @@ static void correct_velocities(struct sim *s)
 /* Step 7a-b for one set: the velocity update, FLIP blended with PIC by flip_fraction (000 §4.5)
  * or APIC (transfer.h), and the position update x += dt sum S v^{t+1}. v_old is overwritten with
  * the nodal increment. */
-static void move_points(struct sim *s, struct particles *p, const double *v_new, double *v_old,
-			double *scratch, int move_positions)
+static void move_points(struct sim *s, struct particles *p, const double *v_new, double *v_old, int move_positions)
 {
-	double *v_pic = scratch, *dv = scratch + 2 * (size_t)p->n;
 	if (s->spec->formulation.velocity_update == VELOCITY_UPDATE_APIC) {
-		v_pic = p->v;   /* APIC's point velocity is the PIC one */
-		gather_velocity(s, p, v_new, p->v);
-	} else {
-		const double alpha = s->spec->formulation.flip_fraction;
-		for (idx_t I = 0; I < 2 * s->grid.node_count; I++)
-			v_old[I] = v_new[I] - v_old[I];
-		g2p_vector(&s->grid, p, v_new, v_pic);
-		g2p_vector(&s->grid, p, v_old, dv);
-		for (idx_t k = 0; k < 2 * p->n; k++)
-			p->v[k] = alpha * (p->v[k] + dv[k]) + (1.0 - alpha) * v_pic[k];
+		gather_velocity(s, p, v_new, p->v);   /* APIC's point velocity is the PIC one */
+		if (move_positions)
+			for (idx_t k = 0; k < 2 * p->n; k++)
+				p->x[k] += s->dt * p->v[k];
+		return;
 	}
-	if (move_positions)
-		for (idx_t k = 0; k < 2 * p->n; k++)
-			p->x[k] += s->dt * v_pic[k];
+	for (idx_t I = 0; I < 2 * s->grid.node_count; I++)
+		v_old[I] = v_new[I] - v_old[I];
+	g2p_flip_update(&s->grid, p, v_new, v_old, s->spec->formulation.flip_fraction, s->dt, move_positions);
 }
 
 /* 000 §5.4's initialisation with gravity.water_attached: the water points take the soil's nodal
@@ -340,12 +337,12 @@ static void attach_water_to_soil(struct sim *s)
 static void update_points(struct sim *s)
 {
 	struct grid_fields *f = &s->f;
-	move_points(s, &s->soil, f->v_s, f->v_s_old, s->soil_grad,
+	move_points(s, &s->soil, f->v_s, f->v_s_old,
 		    s->spec->formulation.position_update == POSITION_UPDATE_GRID_VELOCITY);
 	if (s->spec->gravity.water_attached && in_gravity_ramp(s))
 		attach_water_to_soil(s);
 	else
-		move_points(s, &s->water, f->v_w, f->v_w_old, s->water_vec, s->double_point);
+		move_points(s, &s->water, f->v_w, f->v_w_old, s->double_point);
 	if (s->spec->formulation.pore_pressure_smoothing) {
 		/* 7c with 9a: p^{t+1}_I = p^t_I + dp_I, p^t_I being the smoothed nodal pressure of
 		 * step 2 (Eq. 77's inner sum), interpolated back to the points (Eq. 77's outer sum) */
@@ -606,8 +603,7 @@ enum poro_status semi_implicit_step(struct sim *s)
 	PHASE(PHASE_P2G, {
 		reset_grid(s);
 		map_soil_to_grid(s);                                         /* (2a-d) */
-		project_porosity_to_water(s);                                /* (8h-i) of the last step */
-		map_water_to_grid(s);                                        /* (2e-f) */
+		map_water_to_grid(s);                                        /* (2e-f), (8h-i) */
 	});
 	/* (5b) ahead of the predictors: the weak free-surface condition's G (free_surface.c) needs
 	 * the surface, and nothing it reads changes before the pressure solve */

@@ -134,7 +134,6 @@ static enum poro_status allocate_scratch(struct sim *s)
 	s->soil_grad = calloc(4 * ns, sizeof(double));
 	s->soil_scalar = calloc(ns, sizeof(double));
 	s->soil_coef = calloc(ns, sizeof(double));
-	s->water_vec = calloc(4 * nw, sizeof(double));
 	s->water_scalar = calloc(nw, sizeof(double));
 	s->water_coef = calloc(nw, sizeof(double));
 	s->cell_fill = calloc((size_t)s->grid.cell_count, sizeof(double));
@@ -143,7 +142,7 @@ static enum poro_status allocate_scratch(struct sim *s)
 	s->patch_mass_Je = calloc((size_t)s->grid.cell_count, sizeof(double));
 	s->probe_point = calloc((size_t)s->spec->probe_count + 1, sizeof(int));
 	s->load_bands = calloc((size_t)s->spec->load_count + 1, sizeof *s->load_bands);
-	if (!s->soil_grad || !s->soil_scalar || !s->soil_coef || !s->water_vec || !s->water_scalar ||
+	if (!s->soil_grad || !s->soil_scalar || !s->soil_coef || !s->water_scalar ||
 	    !s->water_coef || !s->cell_fill || !s->cell_fill_soil || !s->patch_mass || !s->patch_mass_Je ||
 	    !s->probe_point || !s->load_bands)
 		return poro_error_set(&s->err, PORO_ENOMEM, "cannot allocate step workspaces");
@@ -219,7 +218,6 @@ void sim_destroy(struct sim **ps)
 	free(s->soil_grad);
 	free(s->soil_scalar);
 	free(s->soil_coef);
-	free(s->water_vec);
 	free(s->water_scalar);
 	free(s->water_coef);
 	free(s->cell_fill);

@@ -60,7 +60,6 @@ struct sim {
 	double *soil_grad;            /* [4 n_soil] velocity or displacement gradient */
 	double *soil_scalar;          /* [n_soil] */
 	double *soil_coef;            /* [n_soil] */
-	double *water_vec;            /* [4 n_water]: two 2-vectors */
 	double *water_scalar;         /* [n_water] */
 	double *water_coef;           /* [n_water] */
 	double *cell_fill;            /* [cell_count] volume of pressure-carrying points per cell, m^3/m */

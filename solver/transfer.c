@@ -7,36 +7,6 @@
  */
 #include "transfer.h"
 
-/* Iterates the support nodes of point q: node index `I`, shape weight `wk`, gradient `gx`, `gy`.
- * The quadratic B-spline's 3x3 support (the default shape) gets its own copy of the body with
- * the support a constant, so the compiler unrolls it; the order of the sums is the same. */
-#define FOR_SUPPORT(g, p, q, ...)                                                    \
-	do {                                                                         \
-		if ((p)->support == 3)                                               \
-			FOR_SUPPORT_OF(3, g, p, q, __VA_ARGS__);                     \
-		else                                                                 \
-			FOR_SUPPORT_OF((p)->support, g, p, q, __VA_ARGS__);          \
-	} while (0)
-
-/* FOR_SUPPORT on a support of S nodes per direction: the weight and gradient are formed from the
- * 1-D factors (particles.h), the same products the shape functions define. */
-#define FOR_SUPPORT_OF(S, g, p, q, ...)                                              \
-	do {                                                                         \
-		const int S_ = (S);                                                  \
-		const double *wx_ = (p)->shape + (size_t)(q) * 4 * S_;               \
-		const double *wy_ = wx_ + S_, *dx_ = wx_ + 2 * S_, *dy_ = wx_ + 3 * S_; \
-		const idx_t base_ = (p)->node0[q];                                   \
-		_Pragma("GCC unroll 4") for (int b_ = 0; b_ < S_; b_++)              \
-			_Pragma("GCC unroll 4") for (int a_ = 0; a_ < S_; a_++) {    \
-				const idx_t I = base_ + a_ + b_ * (g)->nodes[0];     \
-				const double wk = wx_[a_] * wy_[b_];                 \
-				const double gx = dx_[a_] * wy_[b_];                 \
-				const double gy = wx_[a_] * dy_[b_];                 \
-				(void)wk, (void)gx, (void)gy;                        \
-				__VA_ARGS__                                          \
-			}                                                            \
-	} while (0)
-
 void p2g_scalar(const struct grid *g, const struct particles *p, const double *weight,
 		const double *value, double *out)
 {
@@ -103,20 +73,6 @@ void g2p_vector(const struct grid *g, const struct particles *p, const double *n
 	}
 }
 
-void g2p_scalar_gradient(const struct grid *g, const struct particles *p, const double *node, double *out)
-{
-#pragma omp parallel for schedule(static)
-	for (idx_t q = 0; q < p->n; q++) {
-		double sx = 0.0, sy = 0.0;
-		FOR_SUPPORT(g, p, q, {
-			sx += gx * node[I];
-			sy += gy * node[I];
-		});
-		out[2 * q] = sx;
-		out[2 * q + 1] = sy;
-	}
-}
-
 void g2p_vector_gradient(const struct grid *g, const struct particles *p, const double *node, double *out)
 {
 #pragma omp parallel for schedule(static)
@@ -132,13 +88,59 @@ void g2p_vector_gradient(const struct grid *g, const struct particles *p, const 
 	}
 }
 
-void g2p_divergence(const struct grid *g, const struct particles *p, const double *node, double *out)
+void p2g_batch(const struct grid *g, const struct particles *p, const struct p2g_batch *b)
+{
+	for (idx_t q = 0; q < p->n; q++)
+		p2g_batch_point(g, p, q, b);
+}
+
+void p2g_point_gradient(const struct grid *g, const struct particles *p, const double *weight, const double *node,
+			double *out)
+{
+	for (idx_t q = 0; q < p->n; q++) {
+		double sx = 0.0, sy = 0.0;
+		FOR_SUPPORT(g, p, q, {
+			sx += gx * node[I];
+			sy += gy * node[I];
+		});
+		const double V = weight ? weight[q] : 1.0, fx = V * sx, fy = V * sy;
+		FOR_SUPPORT(g, p, q, {
+			out[2 * I] += wk * fx;
+			out[2 * I + 1] += wk * fy;
+		});
+	}
+}
+
+void p2g_point_divergence(const struct grid *g, const struct particles *p, const double *weight,
+			  const double *node, double *out)
+{
+	for (idx_t q = 0; q < p->n; q++) {
+		double div = 0.0;
+		FOR_SUPPORT(g, p, q, { div += node[2 * I] * gx + node[2 * I + 1] * gy; });
+		const double s = (weight ? weight[q] : 1.0) * div;
+		FOR_SUPPORT(g, p, q, { out[I] += wk * s; });
+	}
+}
+
+void g2p_flip_update(const struct grid *g, struct particles *p, const double *v_new, const double *dv, double alpha,
+		     double dt, int move)
 {
 #pragma omp parallel for schedule(static)
 	for (idx_t q = 0; q < p->n; q++) {
-		double s = 0.0;
-		FOR_SUPPORT(g, p, q, { s += node[2 * I] * gx + node[2 * I + 1] * gy; });
-		out[q] = s;
+		double px = 0.0, py = 0.0, dx = 0.0, dy = 0.0;
+		FOR_SUPPORT(g, p, q, {
+			px += wk * v_new[2 * I];
+			py += wk * v_new[2 * I + 1];
+			dx += wk * dv[2 * I];
+			dy += wk * dv[2 * I + 1];
+		});
+		double *v = p->v + 2 * q;
+		v[0] = alpha * (v[0] + dx) + (1.0 - alpha) * px;
+		v[1] = alpha * (v[1] + dy) + (1.0 - alpha) * py;
+		if (move) {
+			p->x[2 * q] += dt * px;
+			p->x[2 * q + 1] += dt * py;
+		}
 	}
 }
 

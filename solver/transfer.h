@@ -33,15 +33,9 @@ void g2p_scalar(const struct grid *g, const struct particles *p, const double *n
 /* out_p = sum_I S_Ip node_I for a nodal 2-vector. */
 void g2p_vector(const struct grid *g, const struct particles *p, const double *node, double *out);
 
-/* out_p = sum_I node_I grad S_Ip: gradient of a nodal scalar, 2 per point. */
-void g2p_scalar_gradient(const struct grid *g, const struct particles *p, const double *node, double *out);
-
 /* out_p = sum_I node_I (x) grad S_Ip: gradient of a nodal 2-vector, 4 per point, row-major
  * (d u_x/dx, d u_x/dy, d u_y/dx, d u_y/dy); step 8b uses it for the deformation gradient. */
 void g2p_vector_gradient(const struct grid *g, const struct particles *p, const double *node, double *out);
-
-/* out_p = div of a nodal 2-vector at each point. */
-void g2p_divergence(const struct grid *g, const struct particles *p, const double *node, double *out);
 
 /* APIC, the affine particle-in-cell transfer (Jiang, Schroeder, Selle, Teran and Stomakhin 2015):
  * each point carries a velocity v_p and an affine velocity C_p (4 per point, row-major), and
@@ -59,5 +53,111 @@ void p2g_affine_momentum(const struct grid *g, const struct particles *p, const 
 			 const double *C, double *out);
 void g2p_affine_velocity(const struct grid *g, const struct particles *p, const double *node, double *v,
 			 double *C);
+
+/* Per-point kernels, for a phase that is one loop over the points (STYLE 1) and needs several
+ * transfers of the same point: each point's shape factors are then read once instead of once a
+ * transfer. Every output gets the same sums in the same order as the whole-set kernels above,
+ * so a fused loop's results are bit for bit those of the separate calls. */
+
+/* Iterates the support nodes of point q: node index `I`, shape weight `wk`, gradient `gx`, `gy`.
+ * The quadratic B-spline's 3x3 support (the default shape) gets its own copy of the body with
+ * the support a constant, so the compiler unrolls it; the order of the sums is the same. */
+#define FOR_SUPPORT(g, p, q, ...)                                                    \
+	do {                                                                         \
+		if ((p)->support == 3)                                               \
+			FOR_SUPPORT_OF(3, g, p, q, __VA_ARGS__);                     \
+		else                                                                 \
+			FOR_SUPPORT_OF((p)->support, g, p, q, __VA_ARGS__);          \
+	} while (0)
+
+/* FOR_SUPPORT on a support of S nodes per direction: the weight and gradient are formed from the
+ * 1-D factors (particles.h), the same products the shape functions define. */
+#define FOR_SUPPORT_OF(S, g, p, q, ...)                                              \
+	do {                                                                         \
+		const int S_ = (S);                                                  \
+		const double *wx_ = (p)->shape + (size_t)(q) * 4 * S_;               \
+		const double *wy_ = wx_ + S_, *dx_ = wx_ + 2 * S_, *dy_ = wx_ + 3 * S_; \
+		const idx_t base_ = (p)->node0[q];                                   \
+		_Pragma("GCC unroll 4") for (int b_ = 0; b_ < S_; b_++)              \
+			_Pragma("GCC unroll 4") for (int a_ = 0; a_ < S_; a_++) {    \
+				const idx_t I = base_ + a_ + b_ * (g)->nodes[0];     \
+				const double wk = wx_[a_] * wy_[b_];                 \
+				const double gx = dx_[a_] * wy_[b_];                 \
+				const double gy = wx_[a_] * dy_[b_];                 \
+				(void)wk, (void)gx, (void)gy;                        \
+				__VA_ARGS__                                          \
+			}                                                            \
+	} while (0)
+
+/* One scatter channel: out_I += S_Ip weight_p value_p (NULL weight or value: 1). */
+struct p2g_channel {
+	const double *weight, *value;
+	double *out;
+};
+
+#define P2G_SCALARS_MAX 4
+
+/* Several quantities of one set scattered together: up to P2G_SCALARS_MAX scalar channels and,
+ * when vector.out is set, one 2-vector channel (value 2 per point). Outputs must be distinct. */
+struct p2g_batch {
+	int scalars;
+	struct p2g_channel scalar[P2G_SCALARS_MAX];
+	struct p2g_channel vector;
+};
+
+/* The batch's scatters for point q alone. */
+static inline void p2g_batch_point(const struct grid *g, const struct particles *p, idx_t q,
+				   const struct p2g_batch *b)
+{
+	double s[P2G_SCALARS_MAX];
+	const int K = b->scalars;
+	for (int k = 0; k < K; k++) {
+		const struct p2g_channel *c = &b->scalar[k];
+		s[k] = (c->weight ? c->weight[q] : 1.0) * (c->value ? c->value[q] : 1.0);
+	}
+	if (b->vector.out) {
+		const struct p2g_channel *c = &b->vector;
+		double m = c->weight ? c->weight[q] : 1.0, vx = m * c->value[2 * q], vy = m * c->value[2 * q + 1];
+		double *out = c->out;
+		FOR_SUPPORT(g, p, q, {
+			for (int k = 0; k < K; k++)
+				b->scalar[k].out[I] += wk * s[k];
+			out[2 * I] += wk * vx;
+			out[2 * I + 1] += wk * vy;
+		});
+	} else {
+		FOR_SUPPORT(g, p, q, {
+			for (int k = 0; k < K; k++)
+				b->scalar[k].out[I] += wk * s[k];
+		});
+	}
+}
+
+/* The batch over every point of the set. */
+void p2g_batch(const struct grid *g, const struct particles *p, const struct p2g_batch *b);
+
+/* sum_I S_Ip node_I at point q (g2p_scalar for one point). */
+static inline double g2p_scalar_point(const struct grid *g, const struct particles *p, idx_t q, const double *node)
+{
+	double s = 0.0;
+	FOR_SUPPORT(g, p, q, { s += wk * node[I]; });
+	return s;
+}
+
+/* out_I += sum_p S_Ip weight_p (sum_J node_J grad S_Jp): a nodal scalar's gradient taken at the
+ * points and scattered back (the correction's G dp, Eqs. 67-68), each point's gradient gathered
+ * and scattered in one visit. */
+void p2g_point_gradient(const struct grid *g, const struct particles *p, const double *weight, const double *node,
+			double *out);
+
+/* out_I += sum_p S_Ip weight_p (div of a nodal 2-vector at p): the divergence of Eqs. 62-63
+ * taken at the points and scattered back, likewise. */
+void p2g_point_divergence(const struct grid *g, const struct particles *p, const double *weight,
+			  const double *node, double *out);
+
+/* The FLIP/PIC blend of step 7a-b in one pass (000 §4.5): v_pic = sum_I S_Ip v_new_I, then
+ * v_p = alpha (v_p + sum_I S_Ip dv_I) + (1 - alpha) v_pic and, if move, x_p += dt v_pic. */
+void g2p_flip_update(const struct grid *g, struct particles *p, const double *v_new, const double *dv, double alpha,
+		     double dt, int move);
 
 #endif

@@ -8,6 +8,10 @@
  *   - G2P keeps angular momentum: the points' sum of the same expression equals
  *     sum_I M_I x_I x v_I for any nodal velocity, M_I = sum_p S_Ip m_p;
  * with D_p = sum_I S_Ip (x_I - x_p)(x_I - x_p)^T summed by brute force over the support here.
+ * And the per-point kernels that let a phase be one loop: the batched scatter, the one-point
+ * gather and the FLIP update give bit for bit what the whole-set kernels give (transfer.h
+ * promises it, and the scheme's results rest on it); the fused gradient and divergence scatters
+ * match a brute-force evaluation from shape_1d.
  */
 #include "../harness.h"
 #include "particles.h"
@@ -148,10 +152,151 @@ static void check_kind(enum case_shape kind, const char *label)
 	particles_release(&p);
 }
 
+/* A point's brute-force shape functions from shape_1d: node0 and S, grad S over the support. */
+static idx_t brute_shape(const struct grid *g, enum case_shape kind, const double x[2], double *S, double *Sx,
+			 double *Sy)
+{
+	double wx[SHAPE_SUPPORT_MAX], wy[SHAPE_SUPPORT_MAX], dx[SHAPE_SUPPORT_MAX], dy[SHAPE_SUPPORT_MAX];
+	idx_t i0, j0;
+	shape_1d(kind, (x[0] - g->origin[0]) * g->inv_h, g->cells[0], g->inv_h, &i0, wx, dx);
+	shape_1d(kind, (x[1] - g->origin[1]) * g->inv_h, g->cells[1], g->inv_h, &j0, wy, dy);
+	const int n = shape_support(kind);
+	for (int b = 0; b < n; b++)
+		for (int a = 0; a < n; a++) {
+			S[a + b * n] = wx[a] * wy[b];
+			Sx[a + b * n] = dx[a] * wy[b];
+			Sy[a + b * n] = wx[a] * dy[b];
+		}
+	return i0 + j0 * g->nodes[0];
+}
+
+static double max_abs_difference(const double *a, const double *b, size_t n, double *scale)
+{
+	double worst = 0.0;
+	*scale = 0.0;
+	for (size_t i = 0; i < n; i++) {
+		worst = fmax(worst, fabs(a[i] - b[i]));
+		*scale = fmax(*scale, fabs(b[i]));
+	}
+	return worst;
+}
+
+static void check_fused(enum case_shape kind, const char *label)
+{
+	struct case_grid spec = {.origin = {0.383, -2.117}, .extent = {9 * 0.0611, 5 * 0.0611}, .cell_size = 0.0611};
+	struct grid g;
+	struct particles p;
+	char name[96];
+	grid_init(&g, &spec, NULL);
+	particles_init(&p, POINTS, 0, NULL);
+	double *value[4], *vec = malloc(2 * POINTS * sizeof(double));
+	for (int k = 0; k < 4; k++)
+		value[k] = malloc(POINTS * sizeof(double));
+	for (idx_t q = 0; q < p.n; q++) {
+		p.x[2 * q] = spec.origin[0] + rnd(0, spec.extent[0]);
+		p.x[2 * q + 1] = spec.origin[1] + rnd(0, spec.extent[1]);
+		p.mass[q] = rnd(0.3, 2.9);
+		for (int k = 0; k < 4; k++)
+			value[k][q] = rnd(-3.7, 5.3);
+		vec[2 * q] = rnd(-1.9, 1.9), vec[2 * q + 1] = rnd(-1.9, 1.9);
+	}
+	shape_evaluate(&g, kind, &p, "test", NULL);
+	const size_t N = (size_t)g.node_count;
+	double *fused = calloc(6 * N, sizeof(double)), *apart = calloc(6 * N, sizeof(double));
+	double *node = malloc(2 * N * sizeof(double)), *dnode = malloc(2 * N * sizeof(double));
+	for (size_t I = 0; I < 2 * N; I++)
+		node[I] = rnd(-2.3, 2.3), dnode[I] = rnd(-0.7, 0.7);
+
+	/* the batch: four scalar channels (weighted and not) and a vector channel */
+	const struct p2g_batch b = {
+		.scalars = 4,
+		.scalar = {{NULL, value[0], fused}, {p.mass, value[1], fused + N}, {value[2], NULL, fused + 2 * N},
+			   {p.mass, value[3], fused + 3 * N}},
+		.vector = {p.mass, vec, fused + 4 * N},
+	};
+	p2g_batch(&g, &p, &b);
+	p2g_scalar(&g, &p, NULL, value[0], apart);
+	p2g_scalar(&g, &p, p.mass, value[1], apart + N);
+	p2g_scalar(&g, &p, value[2], NULL, apart + 2 * N);
+	p2g_scalar(&g, &p, p.mass, value[3], apart + 3 * N);
+	p2g_vector(&g, &p, p.mass, vec, apart + 4 * N);
+	snprintf(name, sizeof name, "%s_p2g_batch_is_the_separate_scatters_bit_for_bit", label);
+	CHECK(memcmp(fused, apart, 6 * N * sizeof(double)) == 0, name, "the nodal sums differ");
+
+	/* the one-point gather */
+	g2p_scalar(&g, &p, node, value[0]);
+	idx_t differ = 0;
+	for (idx_t q = 0; q < p.n; q++)
+		differ += g2p_scalar_point(&g, &p, q, node) != value[0][q];
+	snprintf(name, sizeof name, "%s_g2p_scalar_point_is_g2p_scalar_bit_for_bit", label);
+	CHECK(differ == 0, name, "%ld points differ", (long)differ);
+
+	/* the FLIP update against the two gathers and the blend written out */
+	const double alpha = 0.973, dt = 1.37e-3;
+	double *v_ref = malloc(2 * POINTS * sizeof(double)), *x_ref = malloc(2 * POINTS * sizeof(double));
+	double *pic = malloc(2 * POINTS * sizeof(double)), *inc = malloc(2 * POINTS * sizeof(double));
+	g2p_vector(&g, &p, node, pic);
+	g2p_vector(&g, &p, dnode, inc);
+	for (idx_t k = 0; k < 2 * p.n; k++) {
+		v_ref[k] = alpha * (vec[k] + inc[k]) + (1.0 - alpha) * pic[k];
+		x_ref[k] = p.x[k] + dt * pic[k];
+	}
+	memcpy(p.v, vec, 2 * POINTS * sizeof(double));
+	memcpy(inc, p.x, 2 * POINTS * sizeof(double));
+	g2p_flip_update(&g, &p, node, dnode, alpha, dt, 0);
+	const int kept = memcmp(p.x, inc, 2 * POINTS * sizeof(double)) == 0;
+	memcpy(p.v, vec, 2 * POINTS * sizeof(double));
+	g2p_flip_update(&g, &p, node, dnode, alpha, dt, 1);
+	snprintf(name, sizeof name, "%s_g2p_flip_update_is_the_blend_bit_for_bit", label);
+	CHECK(kept && memcmp(p.v, v_ref, 2 * POINTS * sizeof(double)) == 0 &&
+	      memcmp(p.x, x_ref, 2 * POINTS * sizeof(double)) == 0, name,
+	      "positions kept without move: %d; velocities or moved positions differ", kept);
+	memcpy(p.x, inc, 2 * POINTS * sizeof(double));   /* the cache's positions again */
+
+	/* gradient and divergence scattered back, against brute force */
+	memset(fused, 0, 6 * N * sizeof(double));
+	memset(apart, 0, 6 * N * sizeof(double));
+	p2g_point_gradient(&g, &p, value[1], node, fused);
+	p2g_point_divergence(&g, &p, value[2], node, fused + 2 * N);
+	for (idx_t q = 0; q < p.n; q++) {
+		double S[SHAPE_NODES_MAX], Sx[SHAPE_NODES_MAX], Sy[SHAPE_NODES_MAX];
+		const idx_t base = brute_shape(&g, kind, p.x + 2 * q, S, Sx, Sy);
+		const int n = shape_support(kind);
+		double grad[2] = {0, 0}, div = 0;
+		for (int a = 0; a < n * n; a++) {
+			const idx_t I = base + a % n + (a / n) * g.nodes[0];
+			grad[0] += Sx[a] * node[I], grad[1] += Sy[a] * node[I];
+			div += Sx[a] * node[2 * I] + Sy[a] * node[2 * I + 1];
+		}
+		for (int a = 0; a < n * n; a++) {
+			const idx_t I = base + a % n + (a / n) * g.nodes[0];
+			apart[2 * I] += S[a] * value[1][q] * grad[0];
+			apart[2 * I + 1] += S[a] * value[1][q] * grad[1];
+			apart[2 * N + I] += S[a] * value[2][q] * div;
+		}
+	}
+	double scale_g, scale_d;
+	const double err_g = max_abs_difference(fused, apart, 2 * N, &scale_g);
+	const double err_d = max_abs_difference(fused + 2 * N, apart + 2 * N, N, &scale_d);
+	snprintf(name, sizeof name, "%s_p2g_point_gradient_matches_brute_force", label);
+	CHECK(err_g < TOLERANCE * scale_g, name, "difference %.2e of %.2e", err_g, scale_g);
+	snprintf(name, sizeof name, "%s_p2g_point_divergence_matches_brute_force", label);
+	CHECK(err_d < TOLERANCE * scale_d, name, "difference %.2e of %.2e", err_d, scale_d);
+
+	for (int k = 0; k < 4; k++)
+		free(value[k]);
+	free(vec), free(fused), free(apart), free(node), free(dnode);
+	free(v_ref), free(x_ref), free(pic), free(inc);
+	particles_release(&p);
+}
+
 int main(void)
 {
 	check_kind(SHAPE_LINEAR, "linear");
 	check_kind(SHAPE_QUADRATIC_BSPLINE, "quadratic_bspline");
 	check_kind(SHAPE_CUBIC_BSPLINE, "cubic_bspline");
+	check_fused(SHAPE_LINEAR, "linear");
+	check_fused(SHAPE_QUADRATIC_BSPLINE, "quadratic_bspline");
+	check_fused(SHAPE_CUBIC_BSPLINE, "cubic_bspline");
 	HARNESS_EXIT();
 }
