@@ -29,7 +29,7 @@ enum free_surface_condition { FREE_SURFACE_NODES, FREE_SURFACE_INTERPOLATED, FRE
  * step 8a, the field whose gradient also updates F and the volume (docs/numerics.md, "Volumes
  * that follow the motion"). */
 enum position_update { POSITION_UPDATE_GRID_VELOCITY, POSITION_UPDATE_MUSL_DISPLACEMENT };
-enum velocity_update { VELOCITY_UPDATE_FLIP, VELOCITY_UPDATE_APIC };
+enum velocity_update { VELOCITY_UPDATE_FLIP, VELOCITY_UPDATE_APIC, VELOCITY_UPDATE_AFLIP };
 /* Soil-phase stabilisation (000 §4.4.2, docs/numerics.md): none; F-bar with the node-wise averaged
  * volume change (Eqs. 79-80); modified F-bar (Eq. 81), which also scales Be^t to the patch-wise
  * averaged elastic Jacobian (Eqs. 82-83; patch 1.5 h for B-splines, the cell for linear); and the
@@ -77,7 +77,9 @@ struct case_formulation {
 	enum case_shape shape;            /* "linear", "quadratic_bspline" (default) or "cubic_bspline" */
 	int pore_pressure_smoothing;      /* node-wise smoothing, 000 Eq. 77; default true */
 	enum velocity_update velocity_update; /* point velocities: "flip" (default, blended with PIC by
-						 flip_fraction) or "apic" (affine PIC, transfer.h) */
+						 flip_fraction), "apic" (affine PIC, transfer.h) or
+						 "aflip" (FLIP blended by flip_fraction, with
+						 APIC's affine part) */
 	double flip_fraction;             /* 1 = pure FLIP (default), 0 = PIC; velocity update blend */
 	enum pressure_projection pressure_projection; /* "laplacian" (default) or "consistent" */
 	enum soil_stabilisation soil_stabilisation;   /* "none" (default), "fbar", "modified_fbar" or

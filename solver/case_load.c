@@ -62,7 +62,7 @@ static const char *const projection_names[] = { "laplacian", "consistent", NULL 
 static const char *const pressure_stabilisation_names[] = { "none", "second_difference", NULL };
 static const char *const free_surface_names[] = { "nodes", "interpolated", "weak", NULL };
 static const char *const position_update_names[] = { "grid_velocity", "musl_displacement", NULL };
-static const char *const velocity_update_names[] = { "flip", "apic", NULL };
+static const char *const velocity_update_names[] = { "flip", "apic", "aflip", NULL };
 static const char *const stabilisation_names[] = { "none", "fbar", "modified_fbar", "modified_fbar_cellwise",
 							   NULL };
 static const char *const permeability_law_names[] = { "constant", "kozeny_carman", "volume_ratio",

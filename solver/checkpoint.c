@@ -61,7 +61,7 @@ static const struct saved_array saved_arrays[] = {
 	{"x", MEMBER(x), 2, 0, 0},
 	{"x0", MEMBER(x0), 2, 0, 0},
 	{"v", MEMBER(v), 2, 0, 1},
-	{"C", MEMBER(C), 4, 0, 1},      /* APIC runs only (NULL, not saved, otherwise) */
+	{"C", MEMBER(C), 4, 0, 1},      /* APIC and AFLIP runs only (NULL, not saved, otherwise) */
 	{"mass", MEMBER(mass), 1, 0, 1},
 	{"volume", MEMBER(volume), 1, 0, 0},
 	{"volume0", MEMBER(volume0), 1, 0, 0},

@@ -34,7 +34,7 @@ struct particles {
 	double *x0;                 /* [2n] initial position, m (displacement = x - x0) */
 	double *v;                  /* [2n] velocity, m/s */
 	double *C;                  /* [4n] APIC's affine velocity (xx, xy, yx, yy: dv_x/dx, dv_x/dy, ...),
-				       1/s; NULL unless formulation.velocity_update is "apic" */
+				       1/s; NULL with formulation.velocity_update "flip" */
 	double *mass;               /* [n] kg per m thickness; soil: (1-n0) rho_s V0 (Eq. 33), constant;
 				       water: n0 rho_w V0 (Eq. 37) in double point, constant */
 	double *volume;             /* [n] current volume V^t, m^3 per m */

@@ -108,12 +108,18 @@ static void normalise(idx_t nodes, double *field, int width, const double *weigh
 			field[width * I + c] = weight[I] > 0.0 ? field[width * I + c] / weight[I] : 0.0;
 }
 
-/* The point velocities' two transfers, with APIC's affine part when the case asks for it
- * (transfer.h): map_momentum adds out_I += sum_p S_Ip m_p v_p; gather_velocity sets
- * v_p = sum_I S_Ip node_I (PIC) and, with APIC, the points' affine velocities C_p. */
+/* The points carry APIC's affine velocity C_p ("apic" and "aflip", transfer.h). */
+static int affine_velocities(const struct sim *s)
+{
+	return s->spec->formulation.velocity_update != VELOCITY_UPDATE_FLIP;
+}
+
+/* The point velocities' two transfers, with the affine part when the points carry one:
+ * map_momentum adds out_I += sum_p S_Ip m_p v_p; gather_velocity sets v_p = sum_I S_Ip node_I
+ * (PIC) and, with the affine part, the points' affine velocities C_p. */
 static void map_momentum(const struct sim *s, const struct particles *p, double *out)
 {
-	if (s->spec->formulation.velocity_update == VELOCITY_UPDATE_APIC)
+	if (affine_velocities(s))
 		p2g_affine_momentum(&s->grid, p, p->mass, p->v, p->C, out);
 	else
 		p2g_vector(&s->grid, p, p->mass, p->v, out);
@@ -121,7 +127,7 @@ static void map_momentum(const struct sim *s, const struct particles *p, double 
 
 static void gather_velocity(const struct sim *s, struct particles *p, const double *node, double *v)
 {
-	if (s->spec->formulation.velocity_update == VELOCITY_UPDATE_APIC)
+	if (affine_velocities(s))
 		g2p_affine_velocity(&s->grid, p, node, v, p->C);
 	else
 		g2p_vector(&s->grid, p, node, v);
@@ -132,15 +138,15 @@ static void map_soil_to_grid(struct sim *s)
 {
 	const struct particles *p = &s->soil;
 	struct grid_fields *f = &s->f;
-	const int apic = s->spec->formulation.velocity_update == VELOCITY_UPDATE_APIC;
+	const int affine = affine_velocities(s);
 	const struct p2g_batch b = {
 		.scalars = 4,
 		.scalar = {{NULL, p->mass, f->mass_s}, {p->mass, p->porosity, f->porosity},
 			   {NULL, p->volume, f->volume_s}, {p->mass, p->conductivity, f->conductivity}},
-		.vector = {p->mass, p->v, apic ? NULL : f->v_s},   /* APIC's momentum: map_momentum */
+		.vector = {p->mass, p->v, affine ? NULL : f->v_s},   /* the affine momentum: map_momentum */
 	};
 	p2g_batch(&s->grid, p, &b);
-	if (apic)
+	if (affine)
 		map_momentum(s, p, f->v_s);
 	s->mapped_mass_s = 0.0;
 	for (idx_t q = 0; q < p->n; q++)
@@ -167,12 +173,12 @@ static void map_water_to_grid(struct sim *s)
 	struct particles *w = &s->water;
 	struct grid_fields *f = &s->f;
 	const idx_t nodes = s->grid.node_count;
-	const int apic = s->spec->formulation.velocity_update == VELOCITY_UPDATE_APIC;
+	const int affine = affine_velocities(s);
 	const struct p2g_batch b = {
 		.scalars = 3,
 		.scalar = {{NULL, w->volume, f->mass_w_v}, {NULL, w->mass, f->mass_w_points},
 			   {w->mass, w->pressure, f->pressure}},
-		.vector = {w->mass, w->v, apic ? NULL : f->v_w},   /* APIC's momentum: map_momentum */
+		.vector = {w->mass, w->v, affine ? NULL : f->v_w},   /* the affine momentum: map_momentum */
 	};
 	s->mapped_mass_w = 0.0;
 	for (idx_t q = 0; q < w->n; q++) {
@@ -185,7 +191,7 @@ static void map_water_to_grid(struct sim *s)
 		s->mapped_mass_w += w->mass[q];
 		p2g_batch_point(&s->grid, w, q, &b);
 	}
-	if (apic)
+	if (affine)
 		map_momentum(s, w, f->v_w);
 	normalise(nodes, f->v_w, 2, f->mass_w_points);
 	normalise(nodes, f->pressure, 1, f->mass_w_points);
@@ -304,9 +310,9 @@ static void correct_velocities(struct sim *s)
 	boundary_apply(g, f->fix_s, f->v_s);
 }
 
-/* Step 7a-b for one set: the velocity update, FLIP blended with PIC by flip_fraction (000 §4.5)
- * or APIC (transfer.h), and the position update x += dt sum S v^{t+1}. v_old is overwritten with
- * the nodal increment. */
+/* Step 7a-b for one set: the velocity update, FLIP blended with PIC by flip_fraction (000 §4.5),
+ * APIC, or AFLIP (the FLIP blend, and APIC's affine velocity gathered beside it; transfer.h), and
+ * the position update x += dt sum S v^{t+1}. v_old is overwritten with the nodal increment. */
 static void move_points(struct sim *s, struct particles *p, const double *v_new, double *v_old, int move_positions)
 {
 	if (s->spec->formulation.velocity_update == VELOCITY_UPDATE_APIC) {
@@ -319,6 +325,8 @@ static void move_points(struct sim *s, struct particles *p, const double *v_new,
 	for (idx_t I = 0; I < 2 * s->grid.node_count; I++)
 		v_old[I] = v_new[I] - v_old[I];
 	g2p_flip_update(&s->grid, p, v_new, v_old, s->spec->formulation.flip_fraction, s->dt, move_positions);
+	if (s->spec->formulation.velocity_update == VELOCITY_UPDATE_AFLIP)
+		g2p_affine_velocity(&s->grid, p, v_new, NULL, p->C);
 }
 
 /* 000 §5.4's initialisation with gravity.water_attached: the water points take the soil's nodal

@@ -170,7 +170,7 @@ static enum poro_status build(struct sim *s)
 	init_soil_state(s);
 	if ((st = init_water(s)) || (st = allocate_scratch(s)))
 		return st;
-	if (c->formulation.velocity_update == VELOCITY_UPDATE_APIC &&
+	if (c->formulation.velocity_update != VELOCITY_UPDATE_FLIP &&
 	    ((st = particles_add_affine(&s->soil, &s->err)) || (st = particles_add_affine(&s->water, &s->err))))
 		return st;
 	stabilisation_patches_init(s);

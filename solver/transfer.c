@@ -203,7 +203,8 @@ void g2p_affine_velocity(const struct grid *g, const struct particles *p, const 
 				Bxx += ux * dX[a], Bxy += ux * dY[b];
 				Byx += uy * dX[a], Byy += uy * dY[b];
 			}
-		v[2 * q] = vx, v[2 * q + 1] = vy;
+		if (v)
+			v[2 * q] = vx, v[2 * q + 1] = vy;
 		double *Cq = C + 4 * q;
 		Cq[0] = Dxx > floor ? Bxx / Dxx : 0.0;
 		Cq[1] = Dyy > floor ? Bxy / Dyy : 0.0;

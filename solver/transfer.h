@@ -48,7 +48,9 @@ void g2p_vector_gradient(const struct grid *g, const struct particles *p, const 
  * cache was evaluated at, sum_I S_Ip x_I (the shapes reproduce linear fields), so the pair is
  * consistent with the cache however far the points have moved since. For the tensor-product
  * shapes D_p is diagonal: D_xx = sum_a wx_a (X_a - x_p)^2. A direction in which D_p vanishes (a
- * point on an edge node, where the edge-modified basis has one node) gives no affine part. */
+ * point on an edge node, where the edge-modified basis has one node) gives no affine part.
+ * AFLIP (Fei, Guo, Wu, Huang and Gao 2021) keeps the points' FLIP velocities and gathers only
+ * C_p: g2p_affine_velocity then takes v = NULL. */
 void p2g_affine_momentum(const struct grid *g, const struct particles *p, const double *mass, const double *v,
 			 const double *C, double *out);
 void g2p_affine_velocity(const struct grid *g, const struct particles *p, const double *node, double *v,

@@ -412,7 +412,7 @@ static void test_out_of_range(void)
 		free(text);
 	}
 	expect_invalid("unknown velocity update", "/formulation/velocity_update", "\"mls\"",
-		       "/formulation/velocity_update: must be one of 'flip', 'apic', got 'mls'");
+		       "/formulation/velocity_update: must be one of 'flip', 'apic', 'aflip', got 'mls'");
 	expect_invalid("apic with a flip fraction", "/formulation/velocity_update", "\"apic\"",
 		       "/formulation/flip_fraction: blends FLIP with PIC and has no meaning with "
 		       "/formulation/velocity_update \"apic\"");
@@ -423,6 +423,17 @@ static void test_out_of_range(void)
 		struct case_spec *c = load_valid("velocity update by APIC", text);
 		CHECK(c && c->formulation.velocity_update == VELOCITY_UPDATE_APIC, "velocity update read", "got %d",
 		      c ? (int)c->formulation.velocity_update : -1);
+		case_destroy(&c);
+		free(text);
+	}
+	{   /* AFLIP blends like FLIP, so it takes a flip fraction */
+		const struct edit e[] = { { "/formulation/velocity_update", "\"aflip\"" },
+					  { "/formulation/flip_fraction", "0.983" } };
+		char *text = edited(full_case, e, 2);
+		struct case_spec *c = load_valid("velocity update by AFLIP with a flip fraction", text);
+		CHECK(c && c->formulation.velocity_update == VELOCITY_UPDATE_AFLIP &&
+		      c->formulation.flip_fraction == 0.983, "aflip and its flip fraction read", "got %d, %g",
+		      c ? (int)c->formulation.velocity_update : -1, c ? c->formulation.flip_fraction : -1.0);
 		case_destroy(&c);
 		free(text);
 	}

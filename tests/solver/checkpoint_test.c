@@ -505,6 +505,8 @@ int main(int argc, char **argv)
 	test_resume("single_point", "single_point", "flip");
 	test_resume("double_point_apic", "double_point", "apic");
 	test_resume("single_point_apic", "single_point", "apic");
+	test_resume("double_point_aflip", "double_point", "aflip");
+	test_resume("single_point_aflip", "single_point", "aflip");
 	test_refusals();
 	test_run_killed_and_resumed("double_point");
 	test_run_killed_and_resumed("single_point");
