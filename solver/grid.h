@@ -63,6 +63,14 @@ static inline idx_t grid_node(const struct grid *g, idx_t i, idx_t j)
 	return i + j * g->nodes[0];
 }
 
+/* 1 if x lies beyond a grid face, else 0 (a point on a face is inside; NaN counts as inside and
+ * is reported by the next shape evaluation). */
+static inline int grid_beyond_face(const struct grid *g, const double x[2])
+{
+	const double xi = (x[0] - g->origin[0]) * g->inv_h, eta = (x[1] - g->origin[1]) * g->inv_h;
+	return xi < 0 || xi > g->cells[0] || eta < 0 || eta > g->cells[1];
+}
+
 /* Cell index containing x, or -1 if x lies outside the grid. */
 idx_t grid_cell_of(const struct grid *g, const double x[2]);
 

@@ -310,47 +310,59 @@ static void correct_velocities(struct sim *s)
 	boundary_apply(g, f->fix_s, f->v_s);
 }
 
+/* x_p += dt v_p for every point of the set; returns how many then lie beyond a grid face. */
+static idx_t advance_positions(const struct sim *s, struct particles *p)
+{
+	idx_t beyond = 0;
+	for (idx_t q = 0; q < p->n; q++) {
+		p->x[2 * q] += s->dt * p->v[2 * q];
+		p->x[2 * q + 1] += s->dt * p->v[2 * q + 1];
+		beyond += grid_beyond_face(&s->grid, p->x + 2 * q);
+	}
+	return beyond;
+}
+
 /* Step 7a-b for one set: the velocity update, FLIP blended with PIC by flip_fraction (000 §4.5),
  * APIC, or AFLIP (the FLIP blend, and APIC's affine velocity gathered beside it; transfer.h), and
- * the position update x += dt sum S v^{t+1}. v_old is overwritten with the nodal increment. */
-static void move_points(struct sim *s, struct particles *p, const double *v_new, double *v_old, int move_positions)
+ * the position update x += dt sum S v^{t+1}. v_old is overwritten with the nodal increment.
+ * Returns how many moved points lie beyond a grid face (0 if the positions stay). */
+static idx_t move_points(struct sim *s, struct particles *p, const double *v_new, double *v_old, int move_positions)
 {
 	if (s->spec->formulation.velocity_update == VELOCITY_UPDATE_APIC) {
 		gather_velocity(s, p, v_new, p->v);   /* APIC's point velocity is the PIC one */
-		if (move_positions)
-			for (idx_t k = 0; k < 2 * p->n; k++)
-				p->x[k] += s->dt * p->v[k];
-		return;
+		return move_positions ? advance_positions(s, p) : 0;
 	}
 	for (idx_t I = 0; I < 2 * s->grid.node_count; I++)
 		v_old[I] = v_new[I] - v_old[I];
-	g2p_flip_update(&s->grid, p, v_new, v_old, s->spec->formulation.flip_fraction, s->dt, move_positions);
+	const idx_t beyond = g2p_flip_update(&s->grid, p, v_new, v_old, s->spec->formulation.flip_fraction, s->dt,
+					     move_positions);
 	if (s->spec->formulation.velocity_update == VELOCITY_UPDATE_AFLIP)
 		g2p_affine_velocity(&s->grid, p, v_new, NULL, p->C);
+	return beyond;
 }
 
 /* 000 §5.4's initialisation with gravity.water_attached: the water points take the soil's nodal
  * velocity (PIC) and move with it, so the loading causes no seepage between the point sets; the
  * pressure solve still carries the water's weight. Single point: the positions are the soil's. */
-static void attach_water_to_soil(struct sim *s)
+static idx_t attach_water_to_soil(struct sim *s)
 {
 	struct particles *w = &s->water;
 	gather_velocity(s, w, s->f.v_s, w->v);
-	if (s->double_point)
-		for (idx_t k = 0; k < 2 * w->n; k++)
-			w->x[k] += s->dt * w->v[k];
+	return s->double_point ? advance_positions(s, w) : 0;
 }
 
-/* Step 7: points take velocities, positions and the new pore pressure from the grid. */
-static void update_points(struct sim *s)
+/* Step 7: points take velocities, positions and the new pore pressure from the grid. Returns how
+ * many water points lie beyond a grid face (for remove_outflowing_water). */
+static idx_t update_points(struct sim *s)
 {
 	struct grid_fields *f = &s->f;
+	idx_t water_beyond;
 	move_points(s, &s->soil, f->v_s, f->v_s_old,
 		    s->spec->formulation.position_update == POSITION_UPDATE_GRID_VELOCITY);
 	if (s->spec->gravity.water_attached && in_gravity_ramp(s))
-		attach_water_to_soil(s);
+		water_beyond = attach_water_to_soil(s);
 	else
-		move_points(s, &s->water, f->v_w, f->v_w_old, s->double_point);
+		water_beyond = move_points(s, &s->water, f->v_w, f->v_w_old, s->double_point);
 	if (s->spec->formulation.pore_pressure_smoothing) {
 		/* 7c with 9a: p^{t+1}_I = p^t_I + dp_I, p^t_I being the smoothed nodal pressure of
 		 * step 2 (Eq. 77's inner sum), interpolated back to the points (Eq. 77's outer sum) */
@@ -363,18 +375,20 @@ static void update_points(struct sim *s)
 		for (idx_t q = 0; q < s->water.n; q++)
 			s->water.pressure[q] += s->water_scalar[q];
 	}
+	return water_beyond;
 }
 
 /* Water points that crossed a grid face where water moves freely (a drained face, or open air)
  * have left the domain: they are removed and their mass booked as outflow, so the water balance
  * stays checkable (double point only: the single-point water has no points of its own). Point
- * probes following a removed point stop. Crossing a wall is an error reported by step 1. */
-static void remove_outflowing_water(struct sim *s)
+ * probes following a removed point stop. Crossing a wall is an error reported by step 1. The
+ * search is skipped when step 7 found no water point beyond a face (beyond: its count). */
+static void remove_outflowing_water(struct sim *s, idx_t beyond)
 {
 	struct particles *w = &s->water;
 	const struct grid *g = &s->grid;
 	const struct case_boundary *bc = s->spec->boundaries;
-	if (!s->double_point)
+	if (!s->double_point || beyond == 0)
 		return;
 	for (idx_t q = w->n - 1; q >= 0; q--) {
 		double xi = (w->x[2 * q] - g->origin[0]) * g->inv_h, eta = (w->x[2 * q + 1] - g->origin[1]) * g->inv_h;
@@ -620,8 +634,7 @@ enum poro_status semi_implicit_step(struct sim *s)
 	TRY(pressure_solve(s));                                              /* (5) Eq. 60 */
 	PHASE(PHASE_CORRECT, correct_velocities(s));                         /* (6) Eqs. 64-65 */
 	PHASE(PHASE_G2P, {
-		update_points(s);                                            /* (7) */
-		remove_outflowing_water(s);
+		remove_outflowing_water(s, update_points(s));                /* (7) */
 	});
 	PHASE(PHASE_KINEMATICS, st = update_soil_kinematics(s));            /* (8) */
 	if (st)

@@ -122,10 +122,11 @@ void p2g_point_divergence(const struct grid *g, const struct particles *p, const
 	}
 }
 
-void g2p_flip_update(const struct grid *g, struct particles *p, const double *v_new, const double *dv, double alpha,
+idx_t g2p_flip_update(const struct grid *g, struct particles *p, const double *v_new, const double *dv, double alpha,
 		     double dt, int move)
 {
-#pragma omp parallel for schedule(static)
+	idx_t beyond = 0;
+#pragma omp parallel for schedule(static) reduction(+ : beyond)
 	for (idx_t q = 0; q < p->n; q++) {
 		double px = 0.0, py = 0.0, dx = 0.0, dy = 0.0;
 		FOR_SUPPORT(g, p, q, {
@@ -140,8 +141,10 @@ void g2p_flip_update(const struct grid *g, struct particles *p, const double *v_
 		if (move) {
 			p->x[2 * q] += dt * px;
 			p->x[2 * q + 1] += dt * py;
+			beyond += grid_beyond_face(g, p->x + 2 * q);
 		}
 	}
+	return beyond;
 }
 
 /* The offsets X_a - x_p (in metres) of a point's support nodes along one direction, x_p being

@@ -158,8 +158,9 @@ void p2g_point_divergence(const struct grid *g, const struct particles *p, const
 			  const double *node, double *out);
 
 /* The FLIP/PIC blend of step 7a-b in one pass (000 §4.5): v_pic = sum_I S_Ip v_new_I, then
- * v_p = alpha (v_p + sum_I S_Ip dv_I) + (1 - alpha) v_pic and, if move, x_p += dt v_pic. */
-void g2p_flip_update(const struct grid *g, struct particles *p, const double *v_new, const double *dv, double alpha,
+ * v_p = alpha (v_p + sum_I S_Ip dv_I) + (1 - alpha) v_pic and, if move, x_p += dt v_pic.
+ * Returns how many moved points now lie beyond a grid face (grid_beyond_face), 0 without move. */
+idx_t g2p_flip_update(const struct grid *g, struct particles *p, const double *v_new, const double *dv, double alpha,
 		     double dt, int move);
 
 #endif

@@ -254,6 +254,16 @@ static void check_fused(enum case_shape kind, const char *label)
 	      "positions kept without move: %d; velocities or moved positions differ", kept);
 	memcpy(p.x, inc, 2 * POINTS * sizeof(double));   /* the cache's positions again */
 
+	/* its count of points moved beyond a grid face, with a step long enough to move some out */
+	idx_t counted = g2p_flip_update(&g, &p, node, dnode, alpha, 0.071, 1), beyond = 0;
+	for (idx_t q = 0; q < p.n; q++) {
+		const double xi = (p.x[2 * q] - g.origin[0]) / g.h, eta = (p.x[2 * q + 1] - g.origin[1]) / g.h;
+		beyond += xi < 0 || eta < 0 || xi > g.cells[0] || eta > g.cells[1];
+	}
+	snprintf(name, sizeof name, "%s_g2p_flip_update_counts_points_beyond_the_grid", label);
+	CHECK(beyond > 0 && counted == beyond, name, "counted %ld, %ld beyond", (long)counted, (long)beyond);
+	memcpy(p.x, inc, 2 * POINTS * sizeof(double));
+
 	/* AFLIP's gather of the affine part alone gives the C of the full APIC gather */
 	double *C_full = malloc(4 * POINTS * sizeof(double)), *C_only = malloc(4 * POINTS * sizeof(double));
 	g2p_affine_velocity(&g, &p, node, pic, C_full);
