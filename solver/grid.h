@@ -63,12 +63,20 @@ static inline idx_t grid_node(const struct grid *g, idx_t i, idx_t j)
 	return i + j * g->nodes[0];
 }
 
-/* 1 if x lies beyond a grid face, else 0 (a point on a face is inside; NaN counts as inside and
- * is reported by the next shape evaluation). */
-static inline int grid_beyond_face(const struct grid *g, const double x[2])
+/* The grid face x lies beyond (the first of left, right, bottom, top that it crosses), or -1 if
+ * it lies inside (a point on a face is inside; NaN counts as inside and is reported by the next
+ * shape evaluation). */
+static inline int grid_face_beyond(const struct grid *g, const double x[2])
 {
 	const double xi = (x[0] - g->origin[0]) * g->inv_h, eta = (x[1] - g->origin[1]) * g->inv_h;
-	return xi < 0 || xi > g->cells[0] || eta < 0 || eta > g->cells[1];
+	return xi < 0 ? FACE_LEFT : xi > g->cells[0] ? FACE_RIGHT : eta < 0 ? FACE_BOTTOM :
+	       eta > g->cells[1] ? FACE_TOP : -1;
+}
+
+/* 1 if x lies beyond a grid face, else 0. */
+static inline int grid_beyond_face(const struct grid *g, const double x[2])
+{
+	return grid_face_beyond(g, x) >= 0;
 }
 
 /* Cell index containing x, or -1 if x lies outside the grid. */

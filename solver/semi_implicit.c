@@ -386,14 +386,11 @@ static idx_t update_points(struct sim *s)
 static void remove_outflowing_water(struct sim *s, idx_t beyond)
 {
 	struct particles *w = &s->water;
-	const struct grid *g = &s->grid;
 	const struct case_boundary *bc = s->spec->boundaries;
 	if (!s->double_point || beyond == 0)
 		return;
 	for (idx_t q = w->n - 1; q >= 0; q--) {
-		double xi = (w->x[2 * q] - g->origin[0]) * g->inv_h, eta = (w->x[2 * q + 1] - g->origin[1]) * g->inv_h;
-		int face = xi < 0 ? FACE_LEFT : xi > g->cells[0] ? FACE_RIGHT :
-			   eta < 0 ? FACE_BOTTOM : eta > g->cells[1] ? FACE_TOP : -1;
+		const int face = grid_face_beyond(&s->grid, w->x + 2 * q);
 		if (face < 0 || bc[face].water != CONSTRAINT_FREE)
 			continue;
 		s->water_outflow_mass += w->mass[q];
