@@ -101,8 +101,11 @@ $(BUILD)/poro: $(BUILD)/cli/poro.o $(CLIENT_OBJ) $(COMMON_OBJ)
 $(BUILD)/poro-load: $(BUILD)/bench/poro_load.o $(CLIENT_OBJ) $(COMMON_OBJ)
 	$(CC) $(LDFLAGS) $^ -lcurl $(SVC_LIBS) -lm -o $@
 
+# Formats the lines changed since FORMAT_BASE (default HEAD: the uncommitted work) by .clang-format;
+# `make format FORMAT_BASE=origin/main` takes a whole branch. Needs Debian's clang-format.
+FORMAT_BASE ?= HEAD
 format:
-	clang-format -i solver/*.c solver/*.h cli/*.c tools/*.c tests/*/*.c bench/*.c common/*.[ch] $(wildcard client/*.[ch] server/*.[ch] worker/*.[ch])
+	git clang-format --force $(FORMAT_BASE) -- '*.c' '*.h'
 
 clean:
 	rm -rf build build-san
