@@ -12,7 +12,8 @@
  * dt = 1.2e-4 s, to the paper's 6 s (where the loose slide has come to rest, §5.4); and again with
  * 4x4 points per cell, the refinement §5.4 says agrees with 3x3. Ours does not for the loose
  * slope: its pair is 28% apart at 3x3 (a known failure), 3% at 4x4 and 10% at 5x5 (not run
- * here), each variant scattering by about 0.09 m with the seeding (docs/examples.md).
+ * here), each variant scattering by about 0.09 m with the seeding; the dense lead holds at all
+ * three (docs/examples.md).
  *
  * Each run goes through sim_run() into a temporary result.h5 and is measured by the run report
  * (solver/report.h), as a user measures it: the slide front (front_x: the farthest soil that
