@@ -31,6 +31,7 @@
 /* Defaults of optional values (documented in schemas/case.schema.json and docs/case-spec.md). */
 #define DEFAULT_FLUID_DENSITY 1000.0      /* kg/m^3, water */
 #define DEFAULT_FLUID_BULK_MODULUS 2.2e9  /* Pa, water */
+#define DEFAULT_CAVITATED_BULK_MODULUS 1e6 /* Pa: cavitation.c, docs/numerics.md "Cavitation" */
 #define DEFAULT_GRAVITY_Y -9.81           /* m/s^2 */
 #define DEFAULT_PROGRESS_INTERVAL 1.0     /* s of wall time */
 #define DEFAULT_PRESSURE_STABILISATION_FACTOR 10.0 /* the strongest suppression measured without a
@@ -52,6 +53,7 @@ static const struct case_range POSITIVE = { BOUND_OPEN, 0, BOUND_NONE, 0 };
 static const struct case_range NON_NEGATIVE = { BOUND_CLOSED, 0, BOUND_NONE, 0 };
 static const struct case_range FRACTION = { BOUND_CLOSED, 0, BOUND_CLOSED, 1 };
 static const struct case_range POROSITY = { BOUND_OPEN, 0, BOUND_OPEN, 1 };
+static const struct case_range NEGATIVE = { BOUND_NONE, 0, BOUND_OPEN, 0 };
 
 /* Names of enum values, in enum order. */
 static const char *const schema_names[] = { CASE_SCHEMA_VERSION, NULL };
@@ -91,7 +93,8 @@ static const char *const material_keys[] = { "name", "density", NULL };
 static const char *const body_keys[] = { "name", "material", "rectangle", "polygon", "particles_per_cell",
 					 "porosity", "hydraulic_conductivity", "permeability_law", NULL };
 static const char *const box_keys[] = { "min", "max", NULL };
-static const char *const fluid_keys[] = { "density", "bulk_modulus", NULL };
+static const char *const fluid_keys[] = { "density", "bulk_modulus", "cavitation_pressure",
+					  "cavitated_bulk_modulus", NULL };
 static const char *const gravity_keys[] = { "acceleration", "ramp_time", "elastic_loading", "loading_conductivity",
 						"water_attached", NULL };
 static const char *const face_boundary_keys[] = { "soil", "water", "drainage", NULL };
@@ -472,6 +475,16 @@ static void read_fluid(struct case_reader *r, const json_t *root, struct case_sp
 	case_check_keys(r, o, "/fluid", fluid_keys);
 	case_read_number(r, o, "/fluid", "density", CASE_OPTIONAL, &POSITIVE, &c->fluid.density);
 	case_read_number(r, o, "/fluid", "bulk_modulus", CASE_OPTIONAL, &POSITIVE, &c->fluid.bulk_modulus);
+	c->fluid.cavitates = case_has_key(o, "cavitation_pressure");
+	case_read_number(r, o, "/fluid", "cavitation_pressure", CASE_OPTIONAL, &NEGATIVE,
+			 &c->fluid.cavitation_pressure);
+	case_read_number(r, o, "/fluid", "cavitated_bulk_modulus", CASE_OPTIONAL, &POSITIVE,
+			 &c->fluid.cavitated_bulk_modulus);
+	if (!c->fluid.cavitates && case_has_key(o, "cavitated_bulk_modulus"))
+		case_problem(r, "/fluid/cavitated_bulk_modulus", "needs /fluid/cavitation_pressure");
+	/* measured with the nodal condition only (docs/numerics.md, "Cavitation") */
+	if (c->fluid.cavitates && c->formulation.free_surface != FREE_SURFACE_NODES)
+		case_problem(r, "/fluid/cavitation_pressure", "needs /formulation/free_surface \"nodes\"");
 }
 
 static void read_gravity(struct case_reader *r, const json_t *root, struct case_spec *c)
@@ -701,6 +714,7 @@ static void set_defaults(struct case_spec *c)
 	c->formulation.position_update = POSITION_UPDATE_GRID_VELOCITY;
 	c->fluid.density = DEFAULT_FLUID_DENSITY;
 	c->fluid.bulk_modulus = DEFAULT_FLUID_BULK_MODULUS;
+	c->fluid.cavitated_bulk_modulus = DEFAULT_CAVITATED_BULK_MODULUS;
 	c->gravity.acceleration[0] = 0;
 	c->gravity.acceleration[1] = DEFAULT_GRAVITY_Y;
 	c->gravity.ramp_time = 0;

@@ -443,6 +443,7 @@ enum poro_status pressure_solve(struct sim *s)
 		assemble_laplacian(s, w, s->water_coef);
 		assemble_rhs(s);
 	}
+	cavitation_add_storage(s);   /* cavitation.c */
 	idx_t n = build_reduced_system(s, diagonal_mean);
 	double t1 = sim_clock();
 	s->phase_seconds[PHASE_PRESSURE_ASSEMBLY] += t1 - t0;

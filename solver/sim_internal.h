@@ -100,6 +100,9 @@ enum poro_status pressure_solve(struct sim *s);
  * ghost nodes, to the assembled consistent projection (stencil and right-hand side); a ghost node
  * that no penalty line reaches is held at zero (f->dirichlet). pressure_stabilisation.c. */
 void pressure_stabilise(struct sim *s);
+/* Adds the storage of the water points at or beyond fluid.cavitation_pressure to the assembled
+ * pressure matrix's diagonal (either projection); nothing without cavitation. cavitation.c. */
+void cavitation_add_storage(struct sim *s);
 /* G_s and G_w of the consistent projection into ps->grad_s, ps->grad_w (Eqs. 67-68 with the nodal
  * porosity factors; with the weak free-surface condition, its surface term from the surface points
  * free_surface_mark placed). */

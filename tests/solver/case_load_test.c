@@ -273,6 +273,26 @@ static void test_full_loads(const struct case_spec *c)
 	      "constant value", "not 1");
 }
 
+/* fluid.cavitation_pressure is read with its default cavitated bulk modulus, and without it the
+ * water takes any tension (000). */
+static void test_cavitation_keys(void)
+{
+	const struct edit e = { "/fluid/cavitation_pressure", "-9e4" };
+	char *text = edited(full_case, &e, 1);
+	struct case_spec *c = load_valid("cavitation keys", text);
+	if (c)
+		CHECK(c->fluid.cavitates && c->fluid.cavitation_pressure == -9e4 &&
+		      c->fluid.cavitated_bulk_modulus == 1e6, "cavitation pressure with the default bulk modulus",
+		      "cavitates %d, p_cav %g, K_c %g", c->fluid.cavitates, c->fluid.cavitation_pressure,
+		      c->fluid.cavitated_bulk_modulus);
+	case_destroy(&c);
+	free(text);
+	c = load_valid("no cavitation", full_case);
+	if (c)
+		CHECK(!c->fluid.cavitates, "water without cavitation by default", "cavitates %d", c->fluid.cavitates);
+	case_destroy(&c);
+}
+
 static void test_full(void)
 {
 	struct case_spec *c = load_valid("full case loads", full_case);
@@ -454,6 +474,20 @@ static void test_out_of_range(void)
 		       "/loads/2: from and to must lie on the top face of body 'base'");
 	expect_invalid("ramp time zero", "/loads/2/time_function/ramp_time", "0",
 		       "/loads/2/time_function/ramp_time: must be > 0");
+	expect_invalid("cavitation pressure zero", "/fluid/cavitation_pressure", "0",
+		       "/fluid/cavitation_pressure: must be < 0, got 0");
+	expect_invalid("cavitated bulk modulus negative", "/fluid/cavitated_bulk_modulus", "-1e6",
+		       "/fluid/cavitated_bulk_modulus: must be > 0");
+	expect_invalid("cavitated bulk modulus without cavitation", "/fluid/cavitated_bulk_modulus", "1e6",
+		       "/fluid/cavitated_bulk_modulus: needs /fluid/cavitation_pressure");
+	{
+		const struct edit e[] = { { "/fluid/cavitation_pressure", "-1e5" },
+					  { "/formulation/pressure_projection", "\"consistent\"" },
+					  { "/formulation/free_surface", "\"weak\"" } };
+		const char *needles[] = { "/fluid/cavitation_pressure: needs /formulation/free_surface \"nodes\"",
+					  NULL };
+		expect_invalid_edits("cavitation with the weak free surface", full_case, e, 3, needles);
+	}
 	expect_invalid("title too long", "/title",
 		       "\"" "0123456789012345678901234567890123456789012345678901234567890123456789"
 		       "0123456789012345678901234567890123456789012345678901234567890123456789"
@@ -646,6 +680,7 @@ int main(void)
 	repository_root(root, sizeof root);
 	test_minimal();
 	test_full();
+	test_cavitation_keys();
 	test_malformed();
 	test_wrong_types();
 	test_out_of_range();
