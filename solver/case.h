@@ -200,10 +200,9 @@ struct case_spec {
 	struct {
 		double density;           /* rho_w, kg/m^3 */
 		double bulk_modulus;      /* K_w, Pa (unused by the semi-implicit scheme; for the explicit one) */
-		int cavitates;            /* 1: cavitation_pressure given (not in 000, whose water takes any
-					     tension); see cavitation.c */
 		double cavitation_pressure; /* p_cav, the pressure at which the pore water boils, Pa, gauge
-					       (compression positive, as in case files), < 0 */
+					       (compression positive, as in case files), < 0; 0: no limit,
+					       the water takes any tension as in 000 (cavitation.c) */
 		double cavitated_bulk_modulus; /* K_c, Pa: the stiffness of the water once it has cavitated,
 						  the spring on its vapour (cavitation.c) */
 	} fluid;

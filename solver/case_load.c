@@ -475,15 +475,15 @@ static void read_fluid(struct case_reader *r, const json_t *root, struct case_sp
 	case_check_keys(r, o, "/fluid", fluid_keys);
 	case_read_number(r, o, "/fluid", "density", CASE_OPTIONAL, &POSITIVE, &c->fluid.density);
 	case_read_number(r, o, "/fluid", "bulk_modulus", CASE_OPTIONAL, &POSITIVE, &c->fluid.bulk_modulus);
-	c->fluid.cavitates = case_has_key(o, "cavitation_pressure");
 	case_read_number(r, o, "/fluid", "cavitation_pressure", CASE_OPTIONAL, &NEGATIVE,
 			 &c->fluid.cavitation_pressure);
 	case_read_number(r, o, "/fluid", "cavitated_bulk_modulus", CASE_OPTIONAL, &POSITIVE,
 			 &c->fluid.cavitated_bulk_modulus);
-	if (!c->fluid.cavitates && case_has_key(o, "cavitated_bulk_modulus"))
+	const int cavitates = case_has_key(o, "cavitation_pressure");
+	if (!cavitates && case_has_key(o, "cavitated_bulk_modulus"))
 		case_problem(r, "/fluid/cavitated_bulk_modulus", "needs /fluid/cavitation_pressure");
 	/* measured with the nodal condition only (docs/numerics.md, "Cavitation") */
-	if (c->fluid.cavitates && c->formulation.free_surface != FREE_SURFACE_NODES)
+	if (cavitates && c->formulation.free_surface != FREE_SURFACE_NODES)
 		case_problem(r, "/fluid/cavitation_pressure", "needs /formulation/free_surface \"nodes\"");
 }
 

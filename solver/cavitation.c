@@ -33,7 +33,7 @@
 void cavitation_add_storage(struct sim *s)
 {
 	const struct case_spec *c = s->spec;
-	if (!c->fluid.cavitates)
+	if (c->fluid.cavitation_pressure == 0.0)   /* no limit (the loader allows only < 0 otherwise) */
 		return;
 	const struct particles *w = &s->water;   /* the pressure carriers, single point too */
 	struct pressure_system *ps = &s->ps;
