@@ -33,7 +33,11 @@ trap cleanup_workers EXIT
 
 # the workers run a private copy of the solver, so a rebuild of the tree cannot fail a start
 cp "$build/poro-solve" "$SVC_TMP/poro-solve"
-svc_start main --lease-seconds 2
+# Parts f and d run under a 15 s lease: they test fairness and exclusivity, and a lease short enough
+# for part c (2 s) would expire on a machine that stalls a live worker for 2 s, which is the lease
+# doing its job, not a second live attempt. A leaked lease (a job leased to a claimant that has
+# gone) still shows as attempt 2 after 15 s. Part c has its own server with a 2 s lease.
+svc_start main --lease-seconds 15
 check server_starts $? "no server"
 alice=$(svc_token main alice user)
 bob=$(svc_token main bob user)
@@ -119,11 +123,23 @@ print("PASS every_job_succeeded_in_one_attempt" if not bad_end else "FAIL every_
 print("PASS events_queued_running_succeeded" if not bad_seq else "FAIL events_queued_running_succeeded: %s" % bad_seq[:3])
 print("PASS no_job_claimed_by_two_workers" if not twice else "FAIL no_job_claimed_by_two_workers: %s" % list(twice.items())[:5])
 print("PASS every_job_claimed_once" if len(claims) == len(rows) else "FAIL every_job_claimed_once: %d of %d jobs in the workers logs" % (len(claims), len(rows)))
+# what a failure needs to be understood: the server events and the workers lines of the jobs concerned
+for job_id in sorted(set([r[0] for r in bad_end] + [b[0] for b in bad_seq] + list(twice)))[:3]:
+    for e in db.execute("SELECT at, from_state, to_state, attempt, actor, detail FROM events WHERE job_id = ? ORDER BY id", (job_id,)):
+        print("INFO job %d event: %s" % (job_id, e))
+    for w in ("w1", "w2", "w3", "fair"):
+        for line in open("'"$SVC_TMP"'/%s.log" % w):
+            if (" job %d " % job_id) in line:
+                print("INFO job %d %s: %s" % (job_id, w, line.rstrip()))
 '
 for n in 1 2 3; do kill -TERM "${workers[-$n]}" 2>/dev/null; done
 for n in 1 2 3; do wait "${workers[-$n]}" 2>/dev/null; done
 
 # ---- c. SIGSTOP beyond the lease, then SIGCONT ----------------------------------------------------------
+svc_start lease --lease-seconds 2
+check lease_server_starts $? "no server"
+alice=$(svc_token lease alice user)
+pool=$(svc_token lease pool worker)
 start_worker sleepy 1
 sleepy=$worker_pid
 job=$(submit "$alice" long)
