@@ -576,32 +576,49 @@ static enum poro_status update_soil_kinematics(struct sim *s)
 	return PORO_OK;
 }
 
-/* Step 10: stress update through the material interface (Eqs. 69-76). */
+/* Step 10: stress update through the material interface (Eqs. 69-76). The points are independent;
+ * they are shared among the threads in small dynamic chunks (a plastic return costs several times an
+ * elastic one, and plastic points cluster). Every point is updated, and the failure reported is the
+ * lowest-numbered failing point's, as a serial loop would report it, whatever the thread count. */
 static enum poro_status update_stress(struct sim *s)
 {
 	struct particles *p = &s->soil;
-	enum poro_status status = PORO_OK;
 	const int stage = gravity_loading_stage(s);
-	for (idx_t q = 0; q < p->n && status == PORO_OK; q++) {
-		const struct material *m = &s->materials[s->spec->bodies[p->body[q]].material];
-		const double *dF = p->dF + 4 * q;
-		if (stage == 2) {   /* the volume is already this step's: J at the end of the ramp is J / dJ */
-			const double J_ramp = p->volume[q] / p->volume0[q] / (dF[0] * dF[3] - dF[1] * dF[2]);
-			material_reset_reference(m, p->stress + 4 * q, p->Be + 4 * q, J_ramp, p->state + STATE_MAX * q);
-			p->plastic_strain[q] = 0.0;
+	idx_t first_failure = p->n;
+	#pragma omp parallel
+	{
+		struct poro_error err;   /* filled by the thread's first failure only */
+		idx_t failed = p->n;
+		#pragma omp for schedule(dynamic, 64)
+		for (idx_t q = 0; q < p->n; q++) {
+			const struct material *m = &s->materials[s->spec->bodies[p->body[q]].material];
+			const double *dF = p->dF + 4 * q;
+			if (stage == 2) {   /* the volume is already this step's: J at the end of the ramp is J / dJ */
+				const double J_ramp = p->volume[q] / p->volume0[q] / (dF[0] * dF[3] - dF[1] * dF[2]);
+				material_reset_reference(m, p->stress + 4 * q, p->Be + 4 * q, J_ramp,
+							 p->state + STATE_MAX * q);
+				p->plastic_strain[q] = 0.0;
+			}
+			struct stress_update u = {
+				.dF = dF,
+				.J = p->volume[q] / p->volume0[q],
+				.stress = p->stress + 4 * q,
+				.Be = p->Be + 4 * q,
+				.state = p->state + STATE_MAX * q,
+				.plastic_strain = p->plastic_strain + q,
+				.elastic_only = stage == 1,
+			};
+			/* a thread takes its chunks in increasing order: its first failure is its lowest */
+			if (material_update(m, &u, failed < p->n ? NULL : &err) != PORO_OK && failed == p->n)
+				failed = q;
 		}
-		struct stress_update u = {
-			.dF = dF,
-			.J = p->volume[q] / p->volume0[q],
-			.stress = p->stress + 4 * q,
-			.Be = p->Be + 4 * q,
-			.state = p->state + STATE_MAX * q,
-			.plastic_strain = p->plastic_strain + q,
-			.elastic_only = stage == 1,
-		};
-		status = material_update(m, &u, &s->err);
+		#pragma omp critical(stress_update_failure)
+		if (failed < first_failure) {
+			first_failure = failed;
+			s->err = err;
+		}
 	}
-	return status;
+	return first_failure < p->n ? s->err.code : PORO_OK;
 }
 
 /* Runs one phase and adds its wall time to the phase's account. */

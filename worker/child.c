@@ -18,22 +18,37 @@
 
 extern char **environ;
 
-/* environ without OMP_NUM_THREADS, plus OMP_NUM_THREADS=threads; NULL when out of memory. The
- * strings are environ's own except the last, which is env_omp. */
+/* The solver's threads wait for work passively (sleep) unless the worker's own environment says
+ * otherwise. libgomp's default spins between parallel regions, and where solvers share the cores
+ * (several slots, or other work on a shared node) the spinning threads take the cores the working
+ * ones need: two 2-thread landslides side by side on the 2-core development machine took 162 and
+ * 165 s for 5,000 steps spinning, 36 and 38 s passive (one thread each: 36 and 37 s). A solver alone
+ * on its cores loses about 5% (docs/performance.md, "Threads"). */
+static char wait_policy[] = "OMP_WAIT_POLICY=passive";
+
+/* environ without OMP_NUM_THREADS, plus OMP_NUM_THREADS=threads, plus wait_policy when environ has
+ * no OMP_WAIT_POLICY; NULL when out of memory. The strings are environ's own, env_omp and
+ * wait_policy. */
 static char **child_environment(int threads, char *env_omp, size_t size)
 {
 	size_t n = 0;
 	while (environ[n])
 		n++;
-	char **env = calloc(n + 2, sizeof *env);
+	char **env = calloc(n + 3, sizeof *env);
 	if (!env)
 		return NULL;
 	size_t k = 0;
-	for (size_t i = 0; i < n; i++)
-		if (strncmp(environ[i], "OMP_NUM_THREADS=", 16))
-			env[k++] = environ[i];
+	int has_wait_policy = 0;
+	for (size_t i = 0; i < n; i++) {
+		if (!strncmp(environ[i], "OMP_NUM_THREADS=", 16))
+			continue;
+		has_wait_policy |= !strncmp(environ[i], "OMP_WAIT_POLICY=", 16);
+		env[k++] = environ[i];
+	}
 	snprintf(env_omp, size, "OMP_NUM_THREADS=%d", threads > 0 ? threads : 1);
 	env[k++] = env_omp;
+	if (!has_wait_policy)
+		env[k++] = wait_policy;
 	env[k] = NULL;
 	return env;
 }

@@ -30,7 +30,7 @@ import json, sys
 c = json.load(open(sys.argv[1]))
 blow = dict(c, time={"dt": 0.05, "end": 20.0})
 json.dump({"case": blow}, open(sys.argv[2] + "/blow.json", "w"))
-json.dump({"case": c, "wall_time_seconds": 1}, open(sys.argv[2] + "/slow.json", "w"))
+json.dump({"case": c, "wall_time_seconds": 1, "threads": 2}, open(sys.argv[2] + "/slow.json", "w"))
 huge = dict(c, grid=dict(c["grid"], extent=[100.0, 100.0]))   # 16 million nodes
 json.dump({"case": huge}, open(sys.argv[2] + "/huge.json", "w"))
 EOF
@@ -57,6 +57,14 @@ check solver_failure_not_retried $? "state $(field "$id" state), attempt $(field
 
 # ---- the wall-time limit ----------------------------------------------------------------------------
 id=$(submit slow.json)
+# while it runs: the solver's environment carries the job's thread count, and threads that sleep
+# between parallel regions (worker/child.c)
+started() { grep -q "job $id attempt 1: solver started" "$SVC_TMP/w.log"; }
+wait_for 30 started
+pid=$(sed -n "s/.*job $id attempt 1: solver started (pid \([0-9]*\).*/\1/p" "$SVC_TMP/w.log")
+solver_env=$(tr '\0' '\n' < "/proc/$pid/environ" 2>/dev/null | grep '^OMP_' | sort | tr '\n' ' ')
+[ "$solver_env" = "OMP_NUM_THREADS=2 OMP_WAIT_POLICY=passive " ]
+check solver_environment_threads_and_wait_policy $? "solver pid '$pid' environment: '$solver_env'"
 wait_for 30 ended "$id"
 check wall_time_job_ends $? "state $(field "$id" state) after 30 s"
 state=$(field "$id" state) message=$(field "$id" message)
