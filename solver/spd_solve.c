@@ -17,6 +17,7 @@
 
 #include <cholmod.h>
 #include <math.h>
+#include <omp.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -184,8 +185,8 @@ static enum poro_status factorise(struct spd_solver *s, idx_t n, struct poro_err
 	return PORO_OK;
 }
 
-enum poro_status spd_solver_solve(struct spd_solver *s, idx_t n, const idx_t *colptr, const idx_t *rowidx,
-				  const double *values, const double *b, double *x, struct poro_error *err)
+static enum poro_status solve(struct spd_solver *s, idx_t n, const idx_t *colptr, const idx_t *rowidx,
+			      const double *values, const double *b, double *x, struct poro_error *err)
 {
 	if (n == 0)
 		return PORO_OK;
@@ -223,6 +224,21 @@ enum poro_status spd_solver_solve(struct spd_solver *s, idx_t n, const idx_t *co
 	if (!factor_solve(s, n, b, x))
 		return poro_error_set(err, PORO_ESOLVER, "cholmod_solve2 failed (status %d)", s->cm.status);
 	return PORO_OK;
+}
+
+/* CHOLMOD's supernodal factor and solves run on the BLAS, whose OpenMP build splits its work by the
+ * calling thread's thread count: the sums then differ in the last bits between one and two
+ * threads, and the runs part. On one BLAS thread a run is bit for bit the same at any thread
+ * count of the solver, and the pressure system of these grids (a few thousand to a few hundred
+ * thousand unknowns) is factorised no slower (docs/performance.md, "Threads"). */
+enum poro_status spd_solver_solve(struct spd_solver *s, idx_t n, const idx_t *colptr, const idx_t *rowidx,
+				  const double *values, const double *b, double *x, struct poro_error *err)
+{
+	const int threads = omp_get_max_threads();
+	omp_set_num_threads(1);
+	enum poro_status st = solve(s, n, colptr, rowidx, values, b, x, err);
+	omp_set_num_threads(threads);
+	return st;
 }
 
 void spd_solver_counts(const struct spd_solver *s, long *analyses, long *factorisations)
