@@ -229,8 +229,8 @@ static enum poro_status solve(struct spd_solver *s, idx_t n, const idx_t *colptr
 /* CHOLMOD's supernodal factor and solves run on the BLAS, whose OpenMP build splits its work by the
  * calling thread's thread count: the sums then differ in the last bits between one and two
  * threads, and the runs part. On one BLAS thread a run is bit for bit the same at any thread
- * count of the solver, and the pressure system of these grids (a few thousand to a few hundred
- * thousand unknowns) is factorised no slower (docs/performance.md, "Threads"). */
+ * count of the solver; on the landslides' pressure systems the factor-and-solve took about as long
+ * on one BLAS thread as on two, within the machine's timing noise (docs/performance.md, "Threads"). */
 enum poro_status spd_solver_solve(struct spd_solver *s, idx_t n, const idx_t *colptr, const idx_t *rowidx,
 				  const double *values, const double *b, double *x, struct poro_error *err)
 {

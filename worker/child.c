@@ -21,9 +21,9 @@ extern char **environ;
 /* The solver's threads wait for work passively (sleep) unless the worker's own environment says
  * otherwise. libgomp's default spins between parallel regions, and where solvers share the cores
  * (several slots, or other work on a shared node) the spinning threads take the cores the working
- * ones need: two 2-thread landslides side by side on the 2-core development machine took 162 and
- * 165 s for 5,000 steps spinning, 36 and 38 s passive (one thread each: 36 and 37 s). A solver alone
- * on its cores loses about 5% (docs/performance.md, "Threads"). */
+ * ones need: two 2-thread landslides side by side on the 2-core development machine took 3.4 to
+ * 4.5 times as long spinning as passive. Alone on its cores a solver is about as fast either way
+ * (docs/performance.md, "Threads"). */
 static char wait_policy[] = "OMP_WAIT_POLICY=passive";
 
 /* environ without OMP_NUM_THREADS, plus OMP_NUM_THREADS=threads, plus wait_policy when environ has

@@ -6,11 +6,15 @@
  * (double point, consistent projection, Nor-Sand) is stepped side by side on one and on two
  * threads, through the elastic gravity ramp (4,167 steps at this size) and 240 steps into the
  * plastic slide, and every point's position, velocity, stress and pore pressure is compared for
- * exact equality at every step. Before the pressure solve
- * held its BLAS to one thread (spd_solve.c) the two runs differed at the first step (nodal
- * pressure increments by 2e-14 Pa), and at paper size the slide then ran out 0.352 m on one thread
- * and 0.324 m on two (docs/performance.md, "Threads"). The stress update, threaded over the points,
- * runs elastic, resets its reference at the ramp's end and returns Nor-Sand plastically here.
+ * exact equality at every step. Before the pressure solve held its BLAS to one thread
+ * (spd_solve.c) the two runs differed at the first step (nodal pressure increments by 2e-14 Pa),
+ * and at paper size the slide then ran out 0.352 m on one thread and 0.324 m on two
+ * (docs/performance.md, "Threads"). The stress update, threaded over the points, runs elastic,
+ * resets its reference at the ramp's end and returns Nor-Sand plastically here.
+ *
+ * Then several points are broken so that their stress update fails, and the step's error must be
+ * the lowest-numbered failing point's, on one thread as on two (the threaded loop updates every
+ * point and keeps each thread's first failure; semi_implicit.c).
  */
 #include <omp.h>
 #include <string.h>
@@ -51,6 +55,20 @@ static long differing_points(const struct particles *a, const struct particles *
 	return n;
 }
 
+/* Points whose stress update must fail, in no particular order, each with its own negative
+ * out-of-plane elastic stretch Be_zz = -(q + 1), which the failure message prints ("non-positive
+ * stretch (..., -(q + 1)), ..."): the message says which point was reported. */
+static const idx_t broken[] = { 1000, 341, 702, 1100, 301 };
+#define LOWEST_BROKEN_MARK "-302)"   /* point 301 */
+
+/* Breaks the points above and takes one step: it must fail in the stress update. */
+static enum poro_status step_with_broken_points(struct sim *s)
+{
+	for (size_t i = 0; i < sizeof broken / sizeof broken[0]; i++)
+		s->soil.Be[4 * broken[i] + 3] = -(double)(broken[i] + 1);
+	return sim_step(s);
+}
+
 int main(void)
 {
 	struct case_spec *c1 = NULL, *c2 = NULL;
@@ -70,9 +88,22 @@ int main(void)
 			first_step = k;
 	}
 	omp_set_num_threads(threads);
-	CHECK(ok, "thread_count_runs_step", "a step failed: %s", one && two ? sim_error(one)->message : "");
+	CHECK(ok, "thread_count_runs_step", "a step failed: %s / %s", one ? sim_error(one)->message : "",
+	      two ? sim_error(two)->message : "");
 	CHECK(ok && first_step < 0, "thread_count_one_and_two_threads_bit_identical",
 	      "%ld point values differ at step %ld", differences, first_step);
+	if (ok) {
+		omp_set_num_threads(1);
+		const enum poro_status st1 = step_with_broken_points(one);
+		omp_set_num_threads(2);
+		const enum poro_status st2 = step_with_broken_points(two);
+		omp_set_num_threads(threads);
+		const char *m1 = sim_error(one)->message, *m2 = sim_error(two)->message;
+		CHECK(st1 == PORO_ESOLVER && st2 == PORO_ESOLVER && !strcmp(m1, m2) && strstr(m1, LOWEST_BROKEN_MARK),
+		      "thread_count_stress_failure_reports_the_lowest_point",
+		      "status %d / %d, messages '%s' / '%s', want the point marked %s", st1, st2, m1, m2,
+		      LOWEST_BROKEN_MARK);
+	}
 	sim_destroy(&one);
 	sim_destroy(&two);
 	case_destroy(&c1);
