@@ -29,6 +29,7 @@ enum free_surface_condition { FREE_SURFACE_NODES, FREE_SURFACE_INTERPOLATED, FRE
  * step 8a, the field whose gradient also updates F and the volume (docs/numerics.md, "Volumes
  * that follow the motion"). */
 enum position_update { POSITION_UPDATE_GRID_VELOCITY, POSITION_UPDATE_MUSL_DISPLACEMENT };
+enum specific_volume { SPECIFIC_VOLUME_POINT, SPECIFIC_VOLUME_NODAL_AVERAGE };
 enum velocity_update { VELOCITY_UPDATE_FLIP, VELOCITY_UPDATE_APIC, VELOCITY_UPDATE_AFLIP };
 /* Soil-phase stabilisation (000 §4.4.2, docs/numerics.md): none; F-bar with the node-wise averaged
  * volume change (Eqs. 79-80); modified F-bar (Eq. 81), which also scales Be^t to the patch-wise
@@ -92,6 +93,8 @@ struct case_formulation {
 						     (free_surface.c; the last two: consistent projection only) */
 	double free_surface_penalty_factor;   /* > 0, weight of the interpolated condition; default 1e4 */
 	enum position_update position_update; /* soil points: "grid_velocity" (default) or "musl_displacement" */
+	enum specific_volume specific_volume; /* the J of Nor-Sand's v = J v0: "point" (default, 000 Eq. 95)
+						 or "nodal_average" (Eqs. 96-97) */
 };
 
 struct case_grid {

@@ -65,6 +65,7 @@ static const char *const pressure_stabilisation_names[] = { "none", "second_diff
 static const char *const free_surface_names[] = { "nodes", "interpolated", "weak", NULL };
 static const char *const position_update_names[] = { "grid_velocity", "musl_displacement", NULL };
 static const char *const velocity_update_names[] = { "flip", "apic", "aflip", NULL };
+static const char *const specific_volume_names[] = { "point", "nodal_average", NULL };
 static const char *const stabilisation_names[] = { "none", "fbar", "modified_fbar", "modified_fbar_cellwise",
 							   NULL };
 static const char *const permeability_law_names[] = { "constant", "kozeny_carman", "volume_ratio",
@@ -86,7 +87,8 @@ static const char *const formulation_keys[] = { "scheme", "phases", "shape", "po
 						"flip_fraction", "pressure_projection", "soil_stabilisation",
 						"drag_in_correction", "pressure_stabilisation",
 						"pressure_stabilisation_factor", "free_surface",
-						"free_surface_penalty_factor", "position_update", "velocity_update", NULL };
+						"free_surface_penalty_factor", "position_update", "velocity_update",
+						"specific_volume", NULL };
 static const char *const grid_keys[] = { "origin", "extent", "cell_size", NULL };
 /* A material's own keys; its model's keys are checked by case_read_material_model(). */
 static const char *const material_keys[] = { "name", "density", NULL };
@@ -276,6 +278,8 @@ static void read_formulation(struct case_reader *r, const json_t *root, struct c
 			     pressure_stabilisation_names[f->pressure_stabilisation]);
 	f->position_update = read_choice_or(r, o, p, "position_update", CASE_OPTIONAL, position_update_names,
 					    f->position_update);
+	f->specific_volume = read_choice_or(r, o, p, "specific_volume", CASE_OPTIONAL, specific_volume_names,
+					    f->specific_volume);
 	f->free_surface = read_choice_or(r, o, p, "free_surface", CASE_OPTIONAL, free_surface_names, f->free_surface);
 	case_read_number(r, o, p, "free_surface_penalty_factor", CASE_OPTIONAL, &POSITIVE,
 			 &f->free_surface_penalty_factor);
@@ -712,6 +716,7 @@ static void set_defaults(struct case_spec *c)
 	c->formulation.free_surface = FREE_SURFACE_NODES;
 	c->formulation.free_surface_penalty_factor = DEFAULT_FREE_SURFACE_PENALTY_FACTOR;
 	c->formulation.position_update = POSITION_UPDATE_GRID_VELOCITY;
+	c->formulation.specific_volume = SPECIFIC_VOLUME_POINT;
 	c->fluid.density = DEFAULT_FLUID_DENSITY;
 	c->fluid.bulk_modulus = DEFAULT_FLUID_BULK_MODULUS;
 	c->fluid.cavitated_bulk_modulus = DEFAULT_CAVITATED_BULK_MODULUS;

@@ -16,8 +16,8 @@
  * strain: at small strain its Be holds exp(2 eps^e) rather than I.
  *
  * J and the specific volume: nor_sand's specific volume is v = J v0 with the J given here (000 Eq.
- * 95); a scheme with the stabilised Jacobian of Eq. 97 passes that J-bar in J (Eq. 96), which then
- * also divides tau to give sigma.
+ * 95), or v = J_v v0 when the scheme passes the node-wise averaged Jacobian of Eq. 97 in J_v (Eq.
+ * 96). J alone divides tau to give sigma: it is the point's volume ratio, the one its forces use.
  *
  * Internal variables live in the point's state array (STATE_MAX doubles, zero at the start unless
  * init_state says otherwise); a model documents its slots in its file and names the ones worth
@@ -79,6 +79,9 @@ struct stress_update {
 	double dF_zz;            /* out-of-plane stretch increment; 0 (what an initializer that does not
 				    name it leaves) means plane strain, dF_zz = 1 */
 	double J;                /* total Jacobian V/V0 after the step */
+	double J_v;              /* the Jacobian of nor_sand's specific volume v = J_v v0 (000 Eq. 96: the
+				    node-wise average of Eq. 97); 0 (what an initializer that does not
+				    name it leaves) means J (Eq. 95) */
 	double *stress;          /* [4] in: sigma'^t, out: sigma'^{t+1} (xx, yy, xy, zz), Pa */
 	double *Be;              /* [4] elastic left Cauchy-Green (xx, yy, xy, zz) */
 	double *state;           /* [STATE_MAX] internal variables */

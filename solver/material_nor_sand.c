@@ -11,8 +11,8 @@
  *   ev, es     elastic volumetric strain tr e and deviatoric strain sqrt(2/3) |dev e|
  *   p, q       -tr tau / 3 and sqrt(3/2) |dev tau| of the Kirchhoff stress tau
  *   p0, ev0    the point's reference pressure and the elastic volumetric strain at it (state)
- *   pi         image pressure; v, v0 specific volume (v = J v0, 000 Eq. 95; Eq. 96 when the
- *              scheme passes the stabilised J-bar of Eq. 97 as u->J, material.h)
+ *   pi         image pressure; v, v0 specific volume (v = J v0, 000 Eq. 95; v = J_v v0, Eq. 96,
+ *              when the scheme passes the node-wise averaged J of Eq. 97 as u->J_v, material.h)
  *   psi_i      state parameter at the image, v - v_c0 + lambda ln(pi / p_ref)
  *   dl         plastic multiplier, equal to the increment of eps_s^p because dQ/dq = 1
  *   Ed         accumulated deviatoric plastic strain E_d^p of 000 Eq. 92 (state slot 0)
@@ -52,7 +52,7 @@
  *     exactly (E^e = 0; sym2_eigen is closed form and needs no unequal eigenvalues), a zero tangent,
  *     and keeps E_d^p and pi. Once v <= v_crit again the next step starts from Be = I, so the
  *     stress restarts at p = p0 exp(ev0 / kappa) plus what that step's dF adds.
- *   Eqs. 95-97: v = J v0 with J = u->J.
+ *   Eqs. 95-97: v = J v0 with J = u->J, or u->J_v when the scheme gives one.
  *
  * Tangent: Ds = d tau / d e_tr from the linearised system (material.h), with J held fixed; the
  * specific volume's dependence on J is not linearised (J is an input of the update).
@@ -510,7 +510,8 @@ enum poro_status nor_sand_update(const struct material *m, struct stress_update 
 {
 	const struct nor_sand_parameters *n = &m->ns;
 	int finite = m->strain == STRAIN_FINITE;
-	double v = u->J * u->state[NOR_SAND_INITIAL_SPECIFIC_VOLUME];
+	const double J_v = u->J_v > 0.0 ? u->J_v : u->J;   /* Eq. 96 or Eq. 95 */
+	double v = J_v * u->state[NOR_SAND_INITIAL_SPECIFIC_VOLUME];
 	if (v > n->gas_ratio * u->state[NOR_SAND_INITIAL_SPECIFIC_VOLUME]) {
 		gas_like(u, v);
 		return PORO_OK;
@@ -520,7 +521,7 @@ enum poro_status nor_sand_update(const struct material *m, struct stress_update 
 		return PORO_ESOLVER;
 	struct ns_point c;
 	double dev[3], x[3], e[3], s[3], Ds[3][3], G = m->mu;
-	load_point(m, u->state, t.e, u->J, &c, dev);
+	load_point(m, u->state, t.e, J_v, &c, dev);
 	double p_tr = pressure(&c, c.ev_tr), q_tr = 3.0 * G * c.es_tr;
 	double F_tr = yield(n, p_tr, q_tr, c.pi_n, NULL, NULL);
 	if (!isfinite(F_tr))

@@ -20,6 +20,10 @@
  *                position y - displacement_y > ground + tolerance: the front of the soil that
  *                came from the slope, blind to foundation soil heaved in front of the toe (which
  *                toe_x counts); NaN when there is none.
+ *   bulk_front_x the x beyond which lies REPORT_BULK_FRACTION (1%) of the mass of those same
+ *                points: the front of the debris' bulk, which one or a few points running ahead
+ *                (a sheet one point thick, or points stopped at a wall) do not move; NaN when there
+ *                is no such point.
  *   crest_settlement  s(first frame) - s(t), positive down, with s the surface height at x = crest:
  *                the largest y of the soil points with |x - crest| <= h/2; NaN when there is none.
  *   max_gap, max_gap_x  double point only (NaN in single point): the grid is cut into columns
@@ -71,6 +75,7 @@
 #define REPORT_LINE_VERTICES_MAX 64    /* corners of a sampled path: enough to follow a curved shear band */
 #define REPORT_TOLERANCE_SPACINGS 0.25 /* default tolerance, in finest seeding spacings */
 #define REPORT_TIME_SLACK 1e-9         /* a time may lie outside the frames by this much of the run's span */
+#define REPORT_BULK_FRACTION 0.01      /* bulk_front_x: the share of the slope's soil mass ahead of it */
 
 /* The choices a user may override; NAN asks for the default derived from the case. */
 struct report_settings {
@@ -86,6 +91,7 @@ struct report_row {
 	double toe_x;                 /* m */
 	double runout;                /* m */
 	double front_x;               /* m */
+	double bulk_front_x;          /* m */
 	double crest_settlement;      /* m, positive down */
 	double max_gap;               /* m, soil surface above water surface */
 	double max_gap_x;             /* m, centre of the column of max_gap */

@@ -27,6 +27,46 @@ static double front(const double *x, const double *at, long n, double level)
 	return isinf(front_x) ? NAN : front_x;
 }
 
+struct mass_at_x {
+	double x, mass;
+};
+
+static int by_x_descending(const void *a, const void *b)
+{
+	const double xa = ((const struct mass_at_x *)a)->x, xb = ((const struct mass_at_x *)b)->x;
+	return (xa < xb) - (xa > xb);
+}
+
+/* The x beyond which lies `fraction` of the mass of the points x[n] (masses mass[n]) whose reference
+ * positions `at` lie above `level`: walking from the front back, the x of the point at which the
+ * mass passed reaches that share. NaN when no point lies above `level`. */
+static enum poro_status bulk_front(const double *x, const double *at, const double *mass, long n, double level,
+				   double fraction, double *front_x, struct poro_error *err)
+{
+	struct mass_at_x *p = malloc(sizeof *p * (size_t)(n > 0 ? n : 1));
+	if (!p)
+		return poro_error_set(err, PORO_ENOMEM, "cannot allocate %ld points for the bulk front", n);
+	long m = 0;
+	double total = 0.0;
+	for (long i = 0; i < n; i++)
+		if (at[2 * i + 1] > level) {
+			p[m++] = (struct mass_at_x){x[2 * i], mass[i]};
+			total += mass[i];
+		}
+	qsort(p, (size_t)m, sizeof *p, by_x_descending);
+	*front_x = NAN;
+	double passed = 0.0;
+	for (long k = 0; k < m; k++) {
+		passed += p[k].mass;
+		if (passed >= fraction * total) {
+			*front_x = p[k].x;
+			break;
+		}
+	}
+	free(p);
+	return PORO_OK;
+}
+
 /* Surface height at `at`: the largest y of the points within `half` of it in x, NaN when none is. */
 static double surface(const double *x, long n, double at, double half)
 {
@@ -116,8 +156,8 @@ static enum poro_status frame_row(struct report *rep, long frame, struct report_
 				  struct poro_error *err)
 {
 	const struct report_settings *set = &rep->settings;
-	double *soil = NULL, *soil0 = NULL, *water = NULL;
-	long ns = 0, nw = 0;
+	double *soil = NULL, *soil0 = NULL, *water = NULL, *mass = NULL;
+	long ns = 0, nw = 0, nm = 0;
 	enum poro_status st = results_frame_time(rep->results, frame, &row->time, err);
 	if (!st)
 		st = report_read(rep, frame, "soil", "x", 2, &soil, &ns, err);
@@ -126,6 +166,15 @@ static enum poro_status frame_row(struct report *rep, long frame, struct report_
 	if (!st) {
 		row->toe_x = front(soil, soil, ns, set->ground + set->tolerance);
 		row->front_x = front(soil, soil0, ns, set->ground + set->tolerance);
+		st = report_read(rep, frame, "soil", "mass", 1, &mass, &nm, err);
+	}
+	if (!st && nm != ns)
+		st = poro_error_set(err, PORO_EIO, "frame %ld of '%s': %ld soil positions but %ld masses", frame,
+				    rep->path, ns, nm);
+	if (!st)
+		st = bulk_front(soil, soil0, mass, ns, set->ground + set->tolerance, REPORT_BULK_FRACTION,
+				&row->bulk_front_x, err);
+	if (!st) {
 		*top = surface(soil, ns, set->crest, REPORT_CREST_HALF_WIDTH * rep->h);
 		row->max_gap = row->max_gap_x = NAN;
 	}
@@ -136,6 +185,7 @@ static enum poro_status frame_row(struct report *rep, long frame, struct report_
 	free(soil);
 	free(soil0);
 	free(water);
+	free(mass);
 	return st;
 }
 

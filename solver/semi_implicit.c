@@ -585,6 +585,15 @@ static enum poro_status update_stress(struct sim *s)
 	struct particles *p = &s->soil;
 	const int stage = gravity_loading_stage(s);
 	idx_t first_failure = p->n;
+	/* 000 Eqs. 96-97: Nor-Sand's specific volume from J mapped to the nodes and back (step 9's
+	 * node-wise averaging, on the total J^{t+1}); the stress keeps the point's own J */
+	const double *J_v = NULL;
+	if (s->spec->formulation.specific_volume == SPECIFIC_VOLUME_NODAL_AVERAGE) {
+		for (idx_t q = 0; q < p->n; q++)
+			s->soil_scalar[q] = p->volume[q] / p->volume0[q];
+		average_nodewise(s, s->soil_scalar, s->soil_coef);
+		J_v = s->soil_coef;
+	}
 	#pragma omp parallel
 	{
 		struct poro_error err;   /* filled by the thread's first failure only */
@@ -602,6 +611,7 @@ static enum poro_status update_stress(struct sim *s)
 			struct stress_update u = {
 				.dF = dF,
 				.J = p->volume[q] / p->volume0[q],
+				.J_v = J_v ? J_v[q] : 0.0,
 				.stress = p->stress + 4 * q,
 				.Be = p->Be + 4 * q,
 				.state = p->state + STATE_MAX * q,

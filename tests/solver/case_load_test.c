@@ -187,6 +187,7 @@ static void test_minimal_defaults(const struct case_spec *c)
 	CHECK(f->position_update == POSITION_UPDATE_GRID_VELOCITY, "default position update", "got %d",
 	      f->position_update);
 	CHECK(f->velocity_update == VELOCITY_UPDATE_FLIP, "default velocity update", "got %d", f->velocity_update);
+	CHECK(f->specific_volume == SPECIFIC_VOLUME_POINT, "default specific volume", "got %d", f->specific_volume);
 	CHECK(c->bodies[0].permeability_law == PERMEABILITY_CONSTANT, "default permeability law", "got %d",
 	      c->bodies[0].permeability_law);
 	CHECK(c->fluid.density == 1000 && c->fluid.bulk_modulus == 2.2e9, "default fluid",
@@ -414,6 +415,17 @@ static void test_out_of_range(void)
 		struct case_spec *c = load_valid("weak free surface with the consistent projection", text);
 		CHECK(c && c->formulation.free_surface == FREE_SURFACE_WEAK, "weak free surface read", "kind %d",
 		      c ? (int)c->formulation.free_surface : -1);
+		case_destroy(&c);
+		free(text);
+	}
+	expect_invalid("unknown specific volume", "/formulation/specific_volume", "\"cell_average\"",
+		       "/formulation/specific_volume: must be one of 'point', 'nodal_average', got 'cell_average'");
+	{
+		const struct edit e[] = { { "/formulation/specific_volume", "\"nodal_average\"" } };
+		char *text = edited(full_case, e, 1);
+		struct case_spec *c = load_valid("specific volume from the nodal average of J", text);
+		CHECK(c && c->formulation.specific_volume == SPECIFIC_VOLUME_NODAL_AVERAGE, "specific volume read",
+		      "got %d", c ? (int)c->formulation.specific_volume : -1);
 		case_destroy(&c);
 		free(text);
 	}

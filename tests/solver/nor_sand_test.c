@@ -413,6 +413,55 @@ static void check_gas(const struct material *m)
 	CHECK(ok, "nor_sand_gas_like_eq93_both_sides", "see INFO");
 }
 
+/* 000 Eq. 96: the specific volume comes from J_v when the scheme gives one, the stress from the
+ * point's own J. Three updates of one plastic step: (J, no J_v), (J, J_v = J) and (J', J_v = J).
+ * The first two must agree bit for bit; the third has the same Kirchhoff stress and state
+ * (the same v), so its Cauchy stress is the first one's times J / J'. And a J_v beyond
+ * v_crit makes the point gas-like whatever its J (Eq. 93 tests v). */
+static void check_specific_volume_from_J_v(const struct material *m)
+{
+	const double dF[4] = { 1.004, 0.012, -0.003, 0.991 }, zz = 0.999;
+	const double J = 1.07, J2 = 0.93;
+	double stress[3][4], state[3][STATE_MAX], Be[3][4], plastic[3];
+	const double J_v[3] = { 0.0, J, J }, Jp[3] = { J, J, J2 };
+	for (int k = 0; k < 3; k++) {
+		struct start st = { .p0 = 80e3, .pi = 95e3, .Ed = 0.2, .psi_cut = -0.05 };
+		set_state(m, &st, state[k]);
+		const double Be0[4] = { 0.9993, 0.9981, 0.0004, 0.9990 };
+		memcpy(Be[k], Be0, sizeof Be0);
+		for (int c = 0; c < 4; c++)   /* sigma^t with tau^t at the reference: p0 */
+			stress[k][c] = c == 2 ? 0.0 : -80e3;
+		plastic[k] = 0.2;
+		struct poro_error err = {0};
+		struct stress_update u = { .dF = dF, .dF_zz = zz, .J = Jp[k], .J_v = J_v[k], .stress = stress[k],
+					   .Be = Be[k], .state = state[k], .plastic_strain = &plastic[k] };
+		if (material_update(m, &u, &err) != PORO_OK)
+			printf("INFO update %d failed: %s\n", k, err.message);
+	}
+	int same = memcmp(stress[0], stress[1], sizeof stress[0]) == 0 && memcmp(state[0], state[1], sizeof state[0]) == 0;
+	double worst = 0;
+	for (int c = 0; c < 4; c++)
+		worst = fmax(worst, fabs(stress[2][c] * J2 - stress[0][c] * J) / (fabs(stress[0][c] * J) + 1.0));
+	int v_same = state[2][NOR_SAND_SPECIFIC_VOLUME] == state[0][NOR_SAND_SPECIFIC_VOLUME] &&
+		     state[2][NOR_SAND_DEVIATORIC_PLASTIC_STRAIN] == state[0][NOR_SAND_DEVIATORIC_PLASTIC_STRAIN];
+	/* gas-like by J_v alone */
+	double gstress[4] = { -80e3, -80e3, 0, -80e3 }, gstate[STATE_MAX], gBe[4] = { 0.9993, 0.9981, 0.0004, 0.9990 };
+	double gplastic = 0.2;
+	struct start st = { .p0 = 80e3, .pi = 95e3, .Ed = 0.2, .psi_cut = -0.05 };
+	set_state(m, &st, gstate);
+	struct poro_error err = {0};
+	struct stress_update g = { .dF = dF, .dF_zz = zz, .J = 1.0, .J_v = m->ns.gas_ratio * (1 + 1e-9),
+				   .stress = gstress, .Be = gBe, .state = gstate, .plastic_strain = &gplastic };
+	material_update(m, &g, &err);
+	int gas = gstress[0] == 0 && gstress[1] == 0 && gstress[2] == 0 && gstress[3] == 0;
+	printf("INFO nor_sand_specific_volume_from_J_v: J_v = J same bits %d; J' = %.2f: v the same %d, "
+	       "sigma J' against sigma J %.2g relative; J = 1, J_v just past v_crit: stress-free %d; "
+	       "v after the step %.6f (J_v v0 %.6f)\n", same, J2, v_same, worst, gas,
+	       state[2][NOR_SAND_SPECIFIC_VOLUME], J * m->ns.v0);
+	CHECK(same && v_same && worst <= 1e-13 && gas && state[2][NOR_SAND_SPECIFIC_VOLUME] == J * m->ns.v0 &&
+	      plastic[0] > 0.2, "nor_sand_specific_volume_from_J_v", "see INFO");
+}
+
 /* 000 Eq. 113 and material_reset_reference (App. B.4). */
 static void check_initialisation(void)
 {
@@ -575,6 +624,7 @@ int main(void)
 	check_far_shear(&landslide, "nor_sand_liquefied_point_returns_to_tip", 22.77, 540.2e3, 0.1293, 1.7756, 0.371, 1);
 	check_far_shear(&landslide, "nor_sand_point_pulled_apart_keeps_trial_pressure", 4.902e-4, 828.8e3, 267.7, 2.5406, 1.613, 0);
 	check_gas(&fin);
+	check_specific_volume_from_J_v(&fin);
 	check_initialisation();
 	check_undrained(100);
 	check_undrained(200);

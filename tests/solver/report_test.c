@@ -93,6 +93,8 @@ static void place_soil(struct particles *s, const double *x0, int k)
 {
 	for (idx_t q = 0; q < s->n; q++) {
 		double *x = s->x + 2 * q, *sigma = s->stress + 4 * q;
+		/* unequal, the toe's points heavy, so that the bulk front depends on the weighting */
+		s->mass[q] = (x0[2 * q] > 1.9 ? 3.0 : 1.0) + 0.5 * (double)(q % 3);
 		s->x0[2 * q] = x[0] = x0[2 * q];
 		s->x0[2 * q + 1] = x[1] = x0[2 * q + 1];
 		if (k >= 1 && x0[2 * q + 1] > GROUND)
@@ -126,9 +128,31 @@ static void place_water(struct particles *w, const struct particles *s, int k)
 	}
 }
 
+/* The bulk front by brute force: the largest x of a point seeded above the ground with at least
+ * REPORT_BULK_FRACTION of the mass of those points at or beyond its x; NAN when there is none. */
+static double brute_bulk_front(const struct particles *s)
+{
+	double total = 0.0, best = NAN;
+	for (idx_t j = 0; j < s->n; j++)
+		if (s->x0[2 * j + 1] > GROUND + TOLERANCE)
+			total += s->mass[j];
+	for (idx_t i = 0; i < s->n; i++) {
+		if (!(s->x0[2 * i + 1] > GROUND + TOLERANCE))
+			continue;
+		double ahead = 0.0;
+		for (idx_t j = 0; j < s->n; j++)
+			if (s->x0[2 * j + 1] > GROUND + TOLERANCE && s->x[2 * j] >= s->x[2 * i])
+				ahead += s->mass[j];
+		if (ahead >= REPORT_BULK_FRACTION * total && (isnan(best) || s->x[2 * i] > best))
+			best = s->x[2 * i];
+	}
+	return best;
+}
+
 /* Writes dir/result.h5 of the body `geometry` in `phases`; the oscillation index of each frame's
- * soil, straight from oscillation_index(), into direct[FRAMES] (NAN where undefined). */
-static int write_synthetic(const char *dir, const char *phases, const char *geometry, double *direct)
+ * soil, straight from oscillation_index(), into direct[FRAMES] (NAN where undefined), and its bulk
+ * front by brute force into bulk[FRAMES]. */
+static int write_synthetic(const char *dir, const char *phases, const char *geometry, double *direct, double *bulk)
 {
 	char json[4096];
 	snprintf(json, sizeof json, case_format, phases, geometry);
@@ -146,6 +170,7 @@ static int write_synthetic(const char *dir, const char *phases, const char *geom
 	for (int k = 0; !rc && k < FRAMES; k++) {
 		place_soil(&soil, sim_soil(sim)->x0, k);
 		place_water(&water, &soil, k);
+		bulk[k] = brute_bulk_front(&soil);
 		struct poro_error undefined = {0};
 		if (oscillation_index(&c->grid, &soil, SPACING, &direct[k], &undefined))
 			direct[k] = NAN;
@@ -182,7 +207,8 @@ static void check_settings(const struct report *rep, const char *label)
 	      CREST, s->tolerance, TOLERANCE);
 }
 
-static void check_rows(const struct report_row *r, long count, const double *direct, int double_point,
+static void check_rows(const struct report_row *r, long count, const double *direct, const double *bulk,
+		       int double_point,
 		       const char *label)
 {
 	char name[128];
@@ -202,6 +228,13 @@ static void check_rows(const struct report_row *r, long count, const double *dir
 	snprintf(name, sizeof name, "%s_front_follows_slope_soil_not_lifted_foundation", label);
 	CHECK(front_ok, name, "front %.15g %.15g %.15g %.15g, want %.15g then %.15g", r[0].front_x, r[1].front_x,
 	      r[2].front_x, r[3].front_x, TOE0, TOE0 + DX);
+	int bulk_ok = count == FRAMES && near(bulk[1], bulk[0] + DX, TOL);
+	for (long k = 0; bulk_ok && k < FRAMES; k++)
+		bulk_ok &= near(r[k].bulk_front_x, bulk[k], TOL);
+	snprintf(name, sizeof name, "%s_bulk_front_is_brute_force_mass_percentile", label);
+	CHECK(bulk_ok, name, "bulk front %.15g %.15g %.15g %.15g, brute force %.15g %.15g %.15g %.15g",
+	      r[0].bulk_front_x, r[1].bulk_front_x, r[2].bulk_front_x, r[3].bulk_front_x, bulk[0], bulk[1], bulk[2],
+	      bulk[3]);
 	snprintf(name, sizeof name, "%s_crest_settlement_is_imposed_settlement", label);
 	CHECK(settle_ok, name, "%.15g %.15g %.15g %.15g, want 0 then %g", r[0].crest_settlement,
 	      r[1].crest_settlement, r[2].crest_settlement, r[3].crest_settlement, DZ);
@@ -341,9 +374,9 @@ static void check_line(struct report *rep, const char *path, const char *carrier
 
 static void check_synthetic(const char *dir, const char *phases)
 {
-	double direct[FRAMES];
+	double direct[FRAMES], bulk[FRAMES];
 	char path[256];
-	if (write_synthetic(dir, phases, slope_polygon, direct)) {
+	if (write_synthetic(dir, phases, slope_polygon, direct, bulk)) {
 		CHECK(0, phases, "cannot write the synthetic result");
 		return;
 	}
@@ -363,7 +396,7 @@ static void check_synthetic(const char *dir, const char *phases)
 		return;
 	}
 	check_settings(rep, phases);
-	check_rows(rows, count, direct, !strcmp(phases, "double_point"), phases);
+	check_rows(rows, count, direct, bulk, !strcmp(phases, "double_point"), phases);
 	check_line(rep, path, !strcmp(phases, "double_point") ? "water" : "soil", phases);
 
 	/* the CSV: a header, one line per frame, NaN as "nan" (frame 0 has no stress) */
@@ -377,7 +410,7 @@ static void check_synthetic(const char *dir, const char *phases)
 	for (char *p = text; p && *p; p++)
 		lines += *p == '\n';
 	snprintf(name, sizeof name, "%s_csv_header_rows_and_nan", phases);
-	const char *head = "time,toe_x,runout,front_x,crest_settlement,max_gap,max_gap_x,oscillation_index\n0,1.975,0,1.975,0,";
+	const char *head = "time,toe_x,runout,front_x,bulk_front_x,crest_settlement,max_gap,max_gap_x,oscillation_index\n0,1.975,0,1.975,";
 	CHECK(!st && text && lines == FRAMES + 1 && !strncmp(text, head, strlen(head)) &&
 	      strstr(text, ",nan\n"), name, "status %d, %d lines:\n%s", st, lines, text ? text : "(unreadable)");
 	free(text);
@@ -407,8 +440,8 @@ static void check_errors(const char *dir, const char *polygon_dir)
 	CHECK(st == PORO_EINVAL && !rep && strstr(err.message, "not a result file") && strstr(err.message, path),
 	      "text_file_is_einval_not_a_result_file", "status %d: %s", st, err.message);
 
-	double direct[FRAMES];
-	if (write_synthetic(dir, "single_point", block_rectangle, direct))
+	double direct[FRAMES], bulk[FRAMES];
+	if (write_synthetic(dir, "single_point", block_rectangle, direct, bulk))
 		CHECK(0, "rectangle_result_written", "cannot write");
 	harness_join(path, sizeof path, dir, "result.h5");
 	st = report_open(&rep, path, &set, &err);

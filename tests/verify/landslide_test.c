@@ -10,23 +10,29 @@
  * (the paper's CFL number), to the paper's 2 s.
  * make verify (PORO_VERIFY_LONG=1): the paper's size, h = 0.025 m, 3x3 points per cell,
  * dt = 1.2e-4 s, to the paper's 6 s (where the loose slide has come to rest, §5.4). §5.4 says its
- * 3x3 agrees with 4x4; ours does not for the loose slope: its pair is 28% apart at 3x3 (a known
- * failure here), 3% at 4x4 and 10% at 5x5, each variant scattering by about 0.09 m with the
+ * 3x3 agrees with 4x4; ours does not for the loose slope: its fronts are 24% apart at 3x3 (a
+ * known failure here), 3% at 4x4 and 10% at 5x5, each variant scattering by about 0.09 m with the
  * seeding, while the dense lead holds at all three (docs/examples.md, from poro-solve runs; the
  * refined seedings are not repeated here, as the gap order at 4x4 is a 1 mm tie that a known
  * failure check would turn into a coin toss).
  *
  * Each run goes through sim_run() into a temporary result.h5 and is measured by the run report
  * (solver/report.h), as a user measures it: the slide front (front_x: the farthest soil that
- * started above the toe plain; the toe itself also counts foundation soil heaved in front of it)
- * and the largest gap between the soil and water surfaces (double point), at the last frame.
+ * started above the toe plain; the toe itself also counts foundation soil heaved in front of it),
+ * the front of the debris' bulk (bulk_front_x: beyond it lies 1% of that soil's mass) and the
+ * largest gap between the soil and water surfaces (double point), at the last frame.
  * Asserted: every run reaches its end without the return mapping failing, soil mass (and water
  * mass, double point) is conserved, the loose slope slides and its double- and single-point
- * run-outs are close (Fig. 10), a gap opens in the dense double-point run (Fig. 9), and the dense
- * double-point slide runs out farther than the single-point one, by more than a cell (Fig. 9).
+ * run-outs are close (Fig. 10), a gap opens in the dense double-point run (Fig. 9), and the
+ * dense double-point slide runs out farther than the single-point one, by more than a cell
+ * (Fig. 9). Whether the loose pair is close depends on the measure: at reduced size by the
+ * fronts (10% apart) and not by the bulk (25%), at paper size by the bulk (17%) and not by the
+ * fronts (24%, the double-point front standing at the far wall); the failing one is a known
+ * failure at each size (docs/examples.md).
  * The gap being wider for dense than for loose sand (Figs. 9-10) is a known failure
  * (docs/examples.md). The reduced runs are repeated with APIC point velocities (velocity_update
- * "apic"; docs/examples.md): there the gap order holds and the dense lead is the known failure.
+ * "apic", an option beyond the paper; docs/examples.md): there the gap order holds and the dense
+ * lead is the known failure.
  * Also (make test): the dense single-point slope with the weak free-surface condition runs to the
  * end (a regression test of its mass floor, free_surface.c).
  */
@@ -54,13 +60,13 @@
 
 struct landslide_run {
 	int ok;
-	double dt, runout, gap, settlement, seconds;
+	double dt, runout, bulk_runout, gap, settlement, seconds;
 	double report_tolerance;   /* m, the report's default: a quarter of the stored case's seeding spacing */
 	double soil_mass_error, water_mass_error;
 };
 
-/* The run report of out_dir/result.h5 at its last frame: run-out of the slide front, largest gap
- * (NaN in single point) and crest settlement. */
+/* The run report of out_dir/result.h5 at its last frame: run-out of the slide front and of the
+ * debris' bulk, largest gap (NaN in single point) and crest settlement. */
 static int measure(const char *out_dir, struct landslide_run *r)
 {
 	char path[256];
@@ -73,6 +79,7 @@ static int measure(const char *out_dir, struct landslide_run *r)
 		 !report_frames(rep, &rows, &n, &err) && n > 1;
 	if (ok) {
 		r->runout = rows[n - 1].front_x - rows[0].front_x;
+		r->bulk_runout = rows[n - 1].bulk_front_x - rows[0].bulk_front_x;
 		r->gap = rows[n - 1].max_gap;
 		r->settlement = rows[n - 1].crest_settlement;
 		r->report_tolerance = report_settings_used(rep)->tolerance;
@@ -133,9 +140,10 @@ static struct landslide_run run_landslide(const char *file, double h, int ppc, d
 
 static void report(const char *label, double h, int ppc, const struct landslide_run *r)
 {
-	printf("INFO landslide %s h=%.3f m %dx%d dt=%.2e s: %s, front run-out %.4f m, crest settlement %.4f m, "
-	       "largest soil-water gap %.4f m, mass error soil %.1e water %.1e, run time %.1f s\n", label, h, ppc,
-	       ppc, r->dt, r->ok ? "ran to the end" : "FAILED", r->runout, r->settlement, r->gap,
+	printf("INFO landslide %s h=%.3f m %dx%d dt=%.2e s: %s, front run-out %.4f m, bulk front run-out %.4f m, "
+	       "crest settlement %.4f m, largest soil-water gap %.4f m, mass error soil %.1e water %.1e, run time "
+	       "%.1f s\n", label, h, ppc, ppc, r->dt, r->ok ? "ran to the end" : "FAILED", r->runout, r->bulk_runout,
+	       r->settlement, r->gap,
 	       r->soil_mass_error, r->water_mass_error, r->seconds);
 }
 
@@ -143,6 +151,7 @@ static void report(const char *label, double h, int ppc, const struct landslide_
 struct known_failures {
 	int gap_order;              /* the dense gap wider than the loose one */
 	int loose_close;            /* the loose run-outs within CLOSE_RUNOUT */
+	int loose_bulk_close;       /* the loose bulk run-outs within CLOSE_RUNOUT */
 	int dense_lead;             /* the dense double-point run-out ahead by more than a cell */
 };
 
@@ -184,16 +193,26 @@ static void check_landslides(double h, int ppc, double paper_end, const char *si
 	      "front run-out double %.4f m single %.4f m, cell %.3f m", ld->runout, ls->runout, h);
 	snprintf(name, sizeof name, "landslide_%s_loose_double_and_single_close", size);
 	const int close = ld->ok && ls->ok && fabs(ld->runout - ls->runout) <= CLOSE_RUNOUT * fmax(ld->runout, ls->runout);
-	if (known->loose_close)   /* FLIP at paper size (docs/examples.md): 28% apart by this measure */
+	if (known->loose_close)   /* FLIP at paper size (docs/examples.md): 24-28% apart by this measure */
 		CHECK_KNOWN_FAILURE(close, name, "front run-out double %.4f m single %.4f m (000 Fig. 10)", ld->runout,
 				    ls->runout);
 	else
 		CHECK(close, name, "front run-out double %.4f m single %.4f m (000 Fig. 10)", ld->runout, ls->runout);
+	/* the same for the debris' bulk (report.h, bulk_front_x), which a few points running ahead or
+	 * stopped at the far wall do not set */
+	snprintf(name, sizeof name, "landslide_%s_loose_double_and_single_bulk_close", size);
+	const int bulk_close = ld->ok && ls->ok &&
+			       fabs(ld->bulk_runout - ls->bulk_runout) <= CLOSE_RUNOUT * fmax(ld->bulk_runout, ls->bulk_runout);
+	if (known->loose_bulk_close)
+		CHECK_KNOWN_FAILURE(bulk_close, name, "bulk front run-out double %.4f m single %.4f m (000 Fig. 10)",
+				    ld->bulk_runout, ls->bulk_runout);
+	else
+		CHECK(bulk_close, name, "bulk front run-out double %.4f m single %.4f m (000 Fig. 10)", ld->bulk_runout,
+		      ls->bulk_runout);
 	snprintf(name, sizeof name, "landslide_%s_dense_double_point_gap_opens", size);
 	CHECK(dd->ok && dd->gap > h / ppc, name, "gap %.4f m, seeding spacing %.4f m (000 Fig. 9)", dd->gap, h / ppc);
 	snprintf(name, sizeof name, "landslide_%s_dense_gap_wider_than_loose", size);
-	/* Not reproduced with FLIP (docs/examples.md): the loose slope's water drains farther below its
-	 * soil */
+	/* Not reproduced (docs/examples.md): the loose slope's water drains farther below its soil */
 	const int gap_order = dd->ok && ld->ok && dd->gap > ld->gap;
 	if (known->gap_order)
 		CHECK_KNOWN_FAILURE(gap_order, name, "gap dense %.4f m loose %.4f m (000 Figs. 9-10: a very narrow gap "
@@ -231,7 +250,7 @@ static void check_weak_surface_runs(void)
 
 int main(void)
 {
-	const struct known_failures flip_reduced = {.gap_order = 1}, flip_paper = {.gap_order = 1, .loose_close = 1},
+	const struct known_failures flip_reduced = {.gap_order = 1, .loose_bulk_close = 1}, flip_paper = {.gap_order = 1, .loose_close = 1},
 				    apic_reduced = {.dense_lead = 1};
 	check_landslides(REDUCED_H, REDUCED_PPC, REDUCED_PAPER_END, "reduced", AS_GIVEN, &flip_reduced);
 	check_landslides(REDUCED_H, REDUCED_PPC, REDUCED_PAPER_END, "reduced_apic", APIC, &apic_reduced);
