@@ -57,6 +57,12 @@ static double state_of(const struct particles *p, idx_t q, int slot)
 	return p->state[STATE_MAX * q + slot];
 }
 
+/* The point's own specific volume, Eq. 95: J v0 with J = V / V0. */
+static double point_J_v0(const struct particles *p, idx_t q)
+{
+	return p->volume[q] / p->volume0[q] * state_of(p, q, NOR_SAND_INITIAL_SPECIFIC_VOLUME);
+}
+
 static void check_point(void)
 {
 	struct case_spec *c = NULL;
@@ -66,8 +72,7 @@ static void check_point(void)
 		const struct particles *p = &s->soil;
 		differ = 0;
 		for (idx_t q = 0; q < p->n; q++)
-			differ += state_of(p, q, NOR_SAND_SPECIFIC_VOLUME) !=
-				  p->volume[q] / p->volume0[q] * state_of(p, q, NOR_SAND_INITIAL_SPECIFIC_VOLUME);
+			differ += state_of(p, q, NOR_SAND_SPECIFIC_VOLUME) != point_J_v0(p, q);
 	}
 	CHECK(differ == 0, "specific_volume_point_is_J_v0", "%ld points differ", differ);
 	sim_destroy(&s);
@@ -83,7 +88,7 @@ static void check_nodal_average(void)
 		const struct particles *p = &s->soil;
 		for (idx_t q = 0; q < p->n; q++) {
 			const double v = state_of(p, q, NOR_SAND_SPECIFIC_VOLUME);
-			const double Jv0 = p->volume[q] / p->volume0[q] * state_of(p, q, NOR_SAND_INITIAL_SPECIFIC_VOLUME);
+			const double Jv0 = point_J_v0(p, q);
 			sum_v += p->mass[q] * v;
 			sum_Jv0 += p->mass[q] * Jv0;
 			mass += p->mass[q];
@@ -92,7 +97,7 @@ static void check_nodal_average(void)
 		const double mean = sum_Jv0 / mass;
 		for (idx_t q = 0; q < p->n; q++) {
 			const double v = state_of(p, q, NOR_SAND_SPECIFIC_VOLUME);
-			const double Jv0 = p->volume[q] / p->volume0[q] * state_of(p, q, NOR_SAND_INITIAL_SPECIFIC_VOLUME);
+			const double Jv0 = point_J_v0(p, q);
 			spread_v += p->mass[q] * (v - mean) * (v - mean);
 			spread_J += p->mass[q] * (Jv0 - mean) * (Jv0 - mean);
 		}
