@@ -21,9 +21,12 @@
  * so each sample is the field at the sample exactly; on another line the points used are counted
  * by brute force from the positions read back (results_read.h). Defaults (ground 0.5, crest 1.02,
  * tolerance h/8) follow from the polygon by the rules of report.h. The same frames are written in
- * single point (no gap, pressure on the soil points). Error tests check status and message.
+ * single point (no gap, pressure on the soil points). Error tests check status and message, also
+ * on copies of the result with one frame's soil displacements, stresses or masses cut short.
  */
 #include "report.h"
+
+#include <hdf5.h>
 
 #include "../harness.h"
 #include "case.h"
@@ -372,6 +375,15 @@ static void check_line(struct report *rep, const char *path, const char *carrier
 
 /* ---- one synthetic file end to end ------------------------------------------------------------- */
 
+/* Opens the result file `path` with the default settings and reads every frame's row. */
+static enum poro_status open_and_read_frames(const char *path, struct report **rep, struct report_row **rows,
+					     long *count, struct poro_error *err)
+{
+	struct report_settings defaults = REPORT_SETTINGS_DEFAULT;
+	enum poro_status st = report_open(rep, path, &defaults, err);
+	return st ? st : report_frames(*rep, rows, count, err);
+}
+
 static void check_synthetic(const char *dir, const char *phases)
 {
 	double direct[FRAMES], bulk[FRAMES];
@@ -384,10 +396,8 @@ static void check_synthetic(const char *dir, const char *phases)
 	struct report_row *rows = NULL;
 	struct poro_error err = {0};
 	long count = 0;
-	struct report_settings defaults = REPORT_SETTINGS_DEFAULT;
-	enum poro_status st = report_open(&rep, harness_join(path, sizeof path, dir, "result.h5"), &defaults, &err);
-	if (!st)
-		st = report_frames(rep, &rows, &count, &err);
+	enum poro_status st = open_and_read_frames(harness_join(path, sizeof path, dir, "result.h5"), &rep, &rows,
+						   &count, &err);
 	char name[128];
 	snprintf(name, sizeof name, "%s_report_opens_and_reads_every_frame", phases);
 	CHECK(!st, name, "report: %s", err.message);
@@ -422,6 +432,77 @@ static void check_synthetic(const char *dir, const char *phases)
 
 /* ---- invalid input ------------------------------------------------------------------------------ */
 
+/* Copies the file `from` to `to` byte for byte; 0 on success. */
+static int copy_file(const char *from, const char *to)
+{
+	FILE *in = fopen(from, "rb"), *out = fopen(to, "wb");
+	char buf[65536];
+	size_t got = 0;
+	int rc = in && out ? 0 : -1;
+	while (!rc && (got = fread(buf, 1, sizeof buf, in)) > 0)
+		rc = fwrite(buf, 1, got, out) == got ? 0 : -1;
+	if (in)
+		fclose(in);
+	if (out && fclose(out))
+		rc = -1;
+	return rc;
+}
+
+/* Replaces frame 1's soil dataset `name` (`columns` per row, 0 for one) of the result file `path`
+ * with one of `rows` zero rows, as a writer cut short or a hand-edited file could leave it. */
+static int shorten_soil_dataset(const char *path, const char *name, int columns, hsize_t rows)
+{
+	char link[128];
+	snprintf(link, sizeof link, "/frames/000001/soil/%s", name);
+	hid_t file = H5Fopen(path, H5F_ACC_RDWR, H5P_DEFAULT);
+	if (file < 0)
+		return -1;
+	hsize_t dims[2] = {rows, (hsize_t)columns};
+	double *zeros = calloc(rows * (hsize_t)(columns ? columns : 1), sizeof *zeros);
+	hid_t space = H5Screate_simple(columns ? 2 : 1, dims, NULL), set = -1;
+	int rc = zeros && space >= 0 && H5Ldelete(file, link, H5P_DEFAULT) >= 0 ? 0 : -1;
+	if (!rc)
+		set = H5Dcreate2(file, link, H5T_NATIVE_DOUBLE, space, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
+	if (!rc && (set < 0 || H5Dwrite(set, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, zeros) < 0))
+		rc = -1;
+	if (set >= 0)
+		H5Dclose(set);
+	if (space >= 0)
+		H5Sclose(space);
+	free(zeros);
+	return H5Fclose(file) < 0 ? -1 : rc;
+}
+
+/* A frame whose soil displacements, stresses or masses do not match its positions row for row is
+ * refused with PORO_EIO naming the frame and both counts, not read past its end. */
+static void check_short_datasets(const char *dir, const char *source)
+{
+	static const struct {
+		const char *dataset, *word;
+		int columns;
+	} cut[] = {{"displacement", "displacements", 2}, {"stress", "stresses", 4}, {"mass", "masses", 0}};
+	for (size_t i = 0; i < sizeof cut / sizeof *cut; i++) {
+		char path[256], name[128], want[64];
+		snprintf(name, sizeof name, "short_%s.h5", cut[i].dataset);
+		harness_join(path, sizeof path, dir, name);
+		snprintf(name, sizeof name, "frame_with_fewer_soil_%s_is_eio", cut[i].word);
+		if (copy_file(source, path) || shorten_soil_dataset(path, cut[i].dataset, cut[i].columns, 3)) {
+			CHECK(0, name, "cannot write the shortened copy %s", path);
+			continue;
+		}
+		struct report *rep = NULL;
+		struct report_row *rows = NULL;
+		struct poro_error err = {0};
+		long count = 0;
+		enum poro_status st = open_and_read_frames(path, &rep, &rows, &count, &err);
+		snprintf(want, sizeof want, "but 3 %s", cut[i].word);
+		CHECK(st == PORO_EIO && !rows && strstr(err.message, "frame 1 ") && strstr(err.message, want) &&
+		      strstr(err.message, path), name, "status %d: %s", st, err.message);
+		free(rows);
+		report_close(&rep);
+	}
+}
+
 static void check_errors(const char *dir, const char *polygon_dir)
 {
 	char path[256], name[128];
@@ -439,6 +520,7 @@ static void check_errors(const char *dir, const char *polygon_dir)
 	st = report_open(&rep, path, &set, &err);
 	CHECK(st == PORO_EINVAL && !rep && strstr(err.message, "not a result file") && strstr(err.message, path),
 	      "text_file_is_einval_not_a_result_file", "status %d: %s", st, err.message);
+	check_short_datasets(dir, harness_join(path, sizeof path, polygon_dir, "result.h5"));
 
 	double direct[FRAMES], bulk[FRAMES];
 	if (write_synthetic(dir, "single_point", block_rectangle, direct, bulk))
