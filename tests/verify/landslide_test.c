@@ -35,7 +35,8 @@
  * "apic", an option beyond the paper; docs/examples.md): there the gap order holds and the dense
  * lead is the known failure, and with it the comparison of the pairs (the dense pair alike).
  * Also (make test): the dense single-point slope with the weak free-surface condition runs to the
- * end (a regression test of its mass floor, free_surface.c).
+ * end (a regression test of its mass floor, free_surface.c); and the loose pair with the water held
+ * in the soil (k = 5e-5 m/s) should agree, which it does not (a known failure, check_nearly_undrained).
  */
 #include <math.h>
 #include <omp.h>
@@ -58,6 +59,7 @@
 #define FULL_PAPER_END 6.0
 #define MASS_TOLERANCE 1e-12        /* relative: points carry constant masses, outflow is booked */
 #define CLOSE_RUNOUT 0.2            /* Fig. 10's "similar": run-outs within 20% of the larger */
+#define NEARLY_UNDRAINED_K 5e-5     /* m/s, 100 times below Table 5: the phases move together */
 
 struct landslide_run {
 	int ok;
@@ -93,11 +95,11 @@ static int measure(const char *out_dir, struct landslide_run *r)
 }
 
 /* What a run changes in its case besides the size. */
-enum change { AS_GIVEN, WEAK_SURFACE, APIC };
+enum change { AS_GIVEN, WEAK_SURFACE, APIC, NEARLY_UNDRAINED };
 
 struct adjustment {
 	double paper_end;   /* s, the paper's time (after the initialisation) to run to */
-	enum change change; /* formulation.free_surface "weak" or velocity_update "apic" */
+	enum change change; /* formulation.free_surface "weak", velocity_update "apic", conductivity */
 };
 
 static void adjust(json_t *doc, void *user)
@@ -109,6 +111,12 @@ static void adjust(json_t *doc, void *user)
 		slope_case_set(doc, "formulation", "free_surface", json_string("weak"));
 	if (a->change == APIC)
 		slope_case_set(doc, "formulation", "velocity_update", json_string("apic"));
+	if (a->change == NEARLY_UNDRAINED) {
+		size_t i;
+		json_t *body;
+		json_array_foreach(json_object_get(doc, "bodies"), i, body)
+			json_object_set_new(body, "hydraulic_conductivity", json_real(NEARLY_UNDRAINED_K));
+	}
 }
 
 static struct landslide_run run_landslide(const char *file, double h, int ppc, double paper_end, enum change change)
@@ -254,6 +262,35 @@ static void check_weak_surface_runs(void)
 	      "see the INFO line");
 }
 
+/* §5.4 explains Fig. 10's similar run-outs by the phases "moving together": where the water cannot
+ * move through the soil, double and single point model the same mixture and should agree. The
+ * loose pair at reduced size with k = NEARLY_UNDRAINED_K (double point's largest gap stays below a
+ * seeding spacing) should run out alike, by the front and by the bulk: within CLOSE_RUNOUT of the
+ * larger or one seeding spacing. It does not (a known failure: docs/examples.md, "Double against
+ * single point where the water cannot move"), so part of the pair's distance at the cases' k is
+ * the formulations', not the relative flow's. */
+static void check_nearly_undrained(void)
+{
+	const double spacing = REDUCED_H / REDUCED_PPC;
+	struct landslide_run d = run_landslide(CASE_DIR "landslide_loose_double_point.json", REDUCED_H, REDUCED_PPC,
+					       REDUCED_PAPER_END, NEARLY_UNDRAINED);
+	struct landslide_run s = run_landslide(CASE_DIR "landslide_loose_single_point.json", REDUCED_H, REDUCED_PPC,
+					       REDUCED_PAPER_END, NEARLY_UNDRAINED);
+	char label[96];
+	snprintf(label, sizeof label, "loose double point, k = %g m/s", NEARLY_UNDRAINED_K);
+	report(label, REDUCED_H, REDUCED_PPC, &d);
+	snprintf(label, sizeof label, "loose single point, k = %g m/s", NEARLY_UNDRAINED_K);
+	report(label, REDUCED_H, REDUCED_PPC, &s);
+	CHECK(d.ok && d.gap < spacing, "landslide_reduced_nearly_undrained_phases_move_together",
+	      "largest gap %.4f m, seeding spacing %.4f m", d.gap, spacing);
+	const int agree = d.ok && s.ok &&
+			  (apart(d.runout, s.runout) <= CLOSE_RUNOUT || fabs(d.runout - s.runout) <= spacing) &&
+			  (apart(d.bulk_runout, s.bulk_runout) <= CLOSE_RUNOUT || fabs(d.bulk_runout - s.bulk_runout) <= spacing);
+	CHECK_KNOWN_FAILURE(agree, "landslide_reduced_nearly_undrained_loose_double_and_single_agree",
+			    "front run-out double %.4f m single %.4f m, bulk %.4f m and %.4f m", d.runout, s.runout,
+			    d.bulk_runout, s.bulk_runout);
+}
+
 int main(void)
 {
 	const struct known_failures flip_reduced = {.gap_order = 1, .loose_bulk_close = 1}, flip_paper = {.gap_order = 1, .loose_close = 1},
@@ -261,6 +298,7 @@ int main(void)
 	check_landslides(REDUCED_H, REDUCED_PPC, REDUCED_PAPER_END, "reduced", AS_GIVEN, &flip_reduced);
 	check_landslides(REDUCED_H, REDUCED_PPC, REDUCED_PAPER_END, "reduced_apic", APIC, &apic_reduced);
 	check_weak_surface_runs();
+	check_nearly_undrained();
 	const char *long_runs = getenv("PORO_VERIFY_LONG");
 	if (long_runs && *long_runs && strcmp(long_runs, "0") != 0)
 		check_landslides(PAPER_H, PAPER_PPC, FULL_PAPER_END, "paper_size", AS_GIVEN, &flip_paper);
