@@ -66,11 +66,11 @@ pid=$(sed -n "s/.*job $id attempt 1: solver started (pid \([0-9]*\).*/\1/p" "$SV
 # environment, so read again until the solver's appears. The limit is 3 s so that on a busy machine
 # the solver is still there to be read (with 1 s it was at times gone)
 solver_env=""
-for i in $(seq 50); do
+read_solver_env() {
 	solver_env=$(tr '\0' '\n' < "/proc/$pid/environ" 2>/dev/null | grep '^OMP_' | sort | tr '\n' ' ')
-	[ -n "$solver_env" ] && break
-	sleep 0.02
-done
+	[ -n "$solver_env" ]
+}
+wait_for 1 read_solver_env
 [ "$solver_env" = "OMP_NUM_THREADS=2 OMP_WAIT_POLICY=passive " ]
 check solver_environment_threads_and_wait_policy $? "solver pid '$pid' environment: '$solver_env'"
 wait_for 30 ended "$id"

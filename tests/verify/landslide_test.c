@@ -262,6 +262,13 @@ static void check_weak_surface_runs(void)
 	      "see the INFO line");
 }
 
+/* Two run-outs within CLOSE_RUNOUT of the larger, or within `spacing` of each other (where both are
+ * a few seeding spacings, a relative measure says nothing). */
+static int alike(double a, double b, double spacing)
+{
+	return apart(a, b) <= CLOSE_RUNOUT || fabs(a - b) <= spacing;
+}
+
 /* §5.4 explains Fig. 10's similar run-outs by the phases "moving together": where the water cannot
  * move through the soil, double and single point model the same mixture and should agree. The
  * loose pair at reduced size with k = NEARLY_UNDRAINED_K (double point's largest gap stays below a
@@ -283,9 +290,7 @@ static void check_nearly_undrained(void)
 	report(label, REDUCED_H, REDUCED_PPC, &s);
 	CHECK(d.ok && d.gap < spacing, "landslide_reduced_nearly_undrained_phases_move_together",
 	      "largest gap %.4f m, seeding spacing %.4f m", d.gap, spacing);
-	const int agree = d.ok && s.ok &&
-			  (apart(d.runout, s.runout) <= CLOSE_RUNOUT || fabs(d.runout - s.runout) <= spacing) &&
-			  (apart(d.bulk_runout, s.bulk_runout) <= CLOSE_RUNOUT || fabs(d.bulk_runout - s.bulk_runout) <= spacing);
+	const int agree = d.ok && s.ok && alike(d.runout, s.runout, spacing) && alike(d.bulk_runout, s.bulk_runout, spacing);
 	CHECK_KNOWN_FAILURE(agree, "landslide_reduced_nearly_undrained_loose_double_and_single_agree",
 			    "front run-out double %.4f m single %.4f m, bulk %.4f m and %.4f m", d.runout, s.runout,
 			    d.bulk_runout, s.bulk_runout);
