@@ -104,7 +104,7 @@ static inline char *harness_read_file(const char *path)
 
 /* A fresh directory /tmp/PREFIX.XXXXXX for a test's files; NULL when none could be made. The
  * names live as long as the program (up to HARNESS_DIRS_MAX of them). */
-#define HARNESS_DIRS_MAX 16
+#define HARNESS_DIRS_MAX 64
 static inline char *harness_temp_dir(const char *prefix)
 {
 	static char dirs[HARNESS_DIRS_MAX][96];
