@@ -402,7 +402,8 @@ second=$(json '["job"]["id"]' < "$SVC_BODY")
 [ "$first" = 1 ] && [ "$second" = "$bjob" ]
 check fair_share_second_claim_is_other_user $? "claims got $first then $second, user b's job is $bjob"
 
-sleep 2.5
+job_state() { svc_req GET "/v1/jobs/$1" "$2" > /dev/null && [ "$(json '["state"]' < "$SVC_BODY")" = "$3" ]; }
+wait_for 10 job_state "$first" "$ua" queued   # the reaper's pass after the 1 s lease
 code=$(svc_req POST "/v1/worker/jobs/$first/heartbeat" "$wk" -d '{"attempt": 1}')
 expect_error stale_attempt_after_lease_expiry_409 409 stale_attempt /attempt "$code"
 code=$(svc_req POST "/v1/worker/jobs/$first/log" "$wk" -d '{"attempt": 1, "offset": 0, "text": "late"}')
@@ -414,11 +415,10 @@ svc_req GET "/v1/jobs/$first" "$ua" > /dev/null
 check lease_expiry_requeues_with_event $? "$(head -c 600 "$SVC_BODY")"
 
 # a cancel requested before the lease expires ends cancelled, not re-queued
-sleep 1.2
 claim "$wk" > /dev/null
 cj=$(json '["job"]["id"]' < "$SVC_BODY")
 svc_req POST "/v1/jobs/$cj/cancel" "$ua" > /dev/null
-sleep 2.5
+wait_for 10 job_state "$cj" "$ua" cancelled
 svc_req GET "/v1/jobs/$cj" "$ua" > /dev/null
 [ "$(json '["state"]' < "$SVC_BODY")" = cancelled ]
 check lease_expiry_with_cancel_requested_cancels $? "job $cj: $(head -c 300 "$SVC_BODY")"

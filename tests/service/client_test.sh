@@ -151,7 +151,8 @@ check logs_follow_shows_lines_while_running $? "job was '$state_at_first_line' w
 # ---- cancel a running job: the solver is gone within seconds --------------------------------------
 id=$("$poro" submit "$tmp/long.json")
 wait_for 20 state_is "$id" running
-sleep 1
+solver_started() { [ -n "$(solver_pids "$id")" ]; }
+wait_for 10 solver_started
 cancelled_pids=$(solver_pids "$id")
 [ -n "$cancelled_pids" ]
 check cancel_target_solver_running $? "no solver process of job $id before the cancel"

@@ -40,7 +40,6 @@ submit() { # BODY-FILE: prints the job id
 }
 field() { svc_req GET "/v1/jobs/$1" "$alice" > /dev/null && json "[\"$2\"]" < "$SVC_BODY"; }
 ended() { case $(field "$1" state) in succeeded|failed|cancelled) return 0 ;; esac; return 1; }
-wait_for() { local t=$1 i; shift; for i in $(seq $((t * 10))); do "$@" && return 0; sleep 0.1; done; return 1; }
 
 # ---- a solver failure is final, with its message --------------------------------------------------
 id=$(submit blow.json)

@@ -124,3 +124,13 @@ svc_header() {
 check() {
 	if [ "$2" -eq 0 ]; then echo "PASS $1"; else echo "FAIL $1: $3"; fi
 }
+
+# wait_for SECONDS COMMAND...: runs COMMAND every 0.1 s until it succeeds (status 0) or SECONDS
+# have passed (status 1). Waiting on the state itself, not a fixed sleep, keeps the tests quick on
+# an idle machine and correct on a loaded one.
+wait_for() {
+	local t=$1 i
+	shift
+	for i in $(seq $((t * 10))); do "$@" && return 0; sleep 0.1; done
+	return 1
+}

@@ -71,12 +71,6 @@ submit() { # TOKEN CASE-NAME: prints the job id
 job_field() { # ID FIELD (as alice)
 	svc_req GET "/v1/jobs/$1" "$alice" > /dev/null && json "[\"$2\"]" < "$SVC_BODY"
 }
-wait_for() { # SECONDS COMMAND...
-	local t=$1 i
-	shift
-	for i in $(seq $((t * 10))); do "$@" && return 0; sleep 0.1; done
-	return 1
-}
 db() { python3 -c 'import sqlite3, sys; db = sqlite3.connect("file:%s?mode=ro" % sys.argv[1], uri=True); exec(sys.argv[2])' "$SVC_STATE/poro.db" "$1"; }
 
 # ---- f. fair share ------------------------------------------------------------------------------------
