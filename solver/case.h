@@ -136,6 +136,9 @@ struct case_material {
 	double dilatancy_multiplier;      /* alpha <= 0: maximum plastic dilatancy D* = alpha psi_i */
 	double initial_specific_volume;   /* v0 > 1 */
 	double overconsolidation_ratio;   /* OCR >= 1, default 1 (000 Eq. 113) */
+	int yield_surface_through_stress; /* 1: the initial image pressure is at least the one whose surface
+					     passes through the point's stress ("initial_yield_surface":
+					     "through_stress"); 0: Eq. 113 alone ("tip", default) */
 	double initial_reference_pressure;/* Pa, > 0, default 2000: p0 of a stress-free point (000 App. B.4) */
 	double dilatancy_cutoff_start;    /* E_d^p,start >= 0, default 1 (000 Eq. 92) */
 	double dilatancy_cutoff_end;      /* E_d^p,end > start, default 1.5 */

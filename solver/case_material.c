@@ -36,7 +36,7 @@ static const char *const strain_names[] = { "finite", "small", NULL };
 		      "yield_function_constant", "plastic_potential_constant", "hardening_coefficient",        \
 		      "dilatancy_multiplier", "initial_specific_volume", "overconsolidation_ratio",            \
 		      "initial_reference_pressure", "dilatancy_cutoff_start", "dilatancy_cutoff_end",          \
-		      "gas_volume_ratio"
+		      "gas_volume_ratio", "initial_yield_surface"
 static const char *const *const model_keys[] = {
 	(const char *const[]){ ELASTIC_KEYS, NULL },
 	(const char *const[]){ ELASTIC_KEYS, NULL },
@@ -160,6 +160,8 @@ static void read_nor_sand(struct case_reader *r, const json_t *o, const char *p,
 	case_read_number(r, o, p, "overconsolidation_ratio", CASE_OPTIONAL, &AT_LEAST_ONE, &m->overconsolidation_ratio);
 	case_read_number(r, o, p, "initial_reference_pressure", CASE_OPTIONAL, &POSITIVE,
 			 &m->initial_reference_pressure);
+	static const char *const surfaces[] = { "tip", "through_stress", NULL };
+	case_read_choice(r, o, p, "initial_yield_surface", CASE_OPTIONAL, surfaces, &m->yield_surface_through_stress);
 	case_read_number(r, o, p, "gas_volume_ratio", CASE_OPTIONAL,
 			 &(struct case_range){ BOUND_OPEN, 1, BOUND_NONE, 0 }, &m->gas_volume_ratio);
 	int ok = case_read_number(r, o, p, "dilatancy_cutoff_start", CASE_OPTIONAL, &NON_NEGATIVE,

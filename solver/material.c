@@ -49,6 +49,7 @@ static void init_nor_sand(struct material *m, const struct case_material *spec)
 	n->v0 = spec->initial_specific_volume;
 	n->ocr = spec->overconsolidation_ratio > 0 ? spec->overconsolidation_ratio : 1.0;
 	n->p_start = spec->initial_reference_pressure > 0 ? spec->initial_reference_pressure : 2e3;
+	n->through_stress = spec->yield_surface_through_stress;
 	n->cutoff_start = spec->dilatancy_cutoff_start;
 	n->cutoff_end = spec->dilatancy_cutoff_end > spec->dilatancy_cutoff_start ? spec->dilatancy_cutoff_end
 										 : spec->dilatancy_cutoff_start + 0.5;

@@ -68,6 +68,7 @@ struct material {
 		double v_c0, p_ref;      /* critical state line v_c = v_c0 - lambda ln(p / p_ref); p_ref Pa */
 		double M, N, N_bar, h, alpha;
 		double v0, ocr, p_start; /* initial specific volume, OCR, p0 of a stress-free point (Pa) */
+		int through_stress;      /* initial surface through the stress, not only Eq. 113 (case.h) */
 		double cutoff_start, cutoff_end;   /* 000 Eq. 92 */
 		double gas_ratio;        /* v_crit / v0, 000 Eq. 93 */
 	} ns;

@@ -443,11 +443,29 @@ static double image_from_ocr(const struct nor_sand_parameters *n, double p0)
 	return n->ocr * p0 / tip_ratio(n);
 }
 
-/* Sets the reference (p0, eps_v0^e), the image pressure (Eq. 113) and the derived slots. */
-static void set_reference(const struct material *m, double p0, double ev0, double J, double *state)
+/* The image pressure whose surface passes through (p, q), p > 0, q >= 0: F(p, q, pi) = 0 of
+ * yield() solved for pi. With N > 0 no surface reaches a stress ratio of M / N or more; such a
+ * stress is taken just below it, and the first plastic step returns the rest. */
+static double image_through(const struct nor_sand_parameters *n, double p, double q)
+{
+	if (!(p > 0.0))
+		return 0.0;   /* no surface holds a point without pressure: Eq. 113 alone */
+	double eta = q / p;
+	if (n->N == 0.0)
+		return p * exp(eta / n->M - 1.0);
+	eta = fmin(eta, (1.0 - 1e-9) * n->M / n->N);
+	return p * exp(log((1.0 - n->N) / (1.0 - eta * n->N / n->M)) * (1.0 - n->N) / n->N);
+}
+
+/* Sets the reference (p0, eps_v0^e), the image pressure and the derived slots. The image pressure
+ * is Eq. 113's; with initial_yield_surface "through_stress" it is at least the one whose surface
+ * passes through the point's present shear q (at p0), so the reference state is not outside. */
+static void set_reference(const struct material *m, double p0, double q, double ev0, double J, double *state)
 {
 	const struct nor_sand_parameters *n = &m->ns;
 	double v = J * state[NOR_SAND_INITIAL_SPECIFIC_VOLUME], pi = image_from_ocr(n, p0);
+	if (n->through_stress)
+		pi = fmax(pi, image_through(n, p0, q));
 	state[NOR_SAND_DEVIATORIC_PLASTIC_STRAIN] = 0.0;
 	state[NOR_SAND_REFERENCE_PRESSURE] = p0;
 	state[NOR_SAND_REFERENCE_STRAIN] = ev0;
@@ -455,6 +473,13 @@ static void set_reference(const struct material *m, double p0, double ev0, doubl
 	state[NOR_SAND_CUTOFF_STATE] = v - n->v_c0 + n->lambda * log(pi / n->p_ref);
 	state[NOR_SAND_SPECIFIC_VOLUME] = v;
 	state[NOR_SAND_STATE_PARAMETER] = v - n->v_c0 + n->lambda * log(p0 / n->p_ref);
+}
+
+/* sqrt(3/2) |dev s| of a (xx, yy, xy, zz) stress. */
+static double shear_invariant(const double *s)
+{
+	double m = (s[0] + s[1] + s[3]) / 3.0, a = s[0] - m, b = s[1] - m, c = s[3] - m;
+	return sqrt(1.5 * (a * a + b * b + c * c + 2.0 * s[2] * s[2]));
 }
 
 /* A point at the effective stress `stress` (tension positive) with eps_v0^e = 0 (000 App. B.3):
@@ -478,7 +503,7 @@ void nor_sand_init_state(const struct material *m, const double *stress, double 
 	Be[1] = s * s * a + c * c * b;
 	Be[2] = c * s * (a - b);
 	Be[3] = exp(2.0 * e[3]);
-	set_reference(m, p, 0.0, 1.0, state);
+	set_reference(m, p, shear_invariant(stress), 0.0, 1.0, state);
 }
 
 void material_reset_reference(const struct material *m, const double *stress, const double *Be, double J,
@@ -486,9 +511,10 @@ void material_reset_reference(const struct material *m, const double *stress, co
 {
 	if (m->model != MODEL_NOR_SAND)
 		return;
-	double p = -(stress[0] + stress[1] + stress[3]) / 3.0 * (m->strain == STRAIN_FINITE ? J : 1.0);
+	const double kirchhoff = m->strain == STRAIN_FINITE ? J : 1.0;
+	double p = -(stress[0] + stress[1] + stress[3]) / 3.0 * kirchhoff;
 	double det = (Be[0] * Be[1] - Be[2] * Be[2]) * Be[3];
-	set_reference(m, p, 0.5 * log(det), J, state);
+	set_reference(m, p, shear_invariant(stress) * kirchhoff, 0.5 * log(det), J, state);
 }
 
 int nor_sand_state_outputs(const struct material *m, const double *state, const char **names, double *values)

@@ -18,7 +18,7 @@ HOSTUN='{"model": "nor_sand", "youngs_modulus": null, "poisson_ratio": null, "sh
 derive() { derive_material "$1" "$HOSTUN" "$2"; }
 bad() { expect_invalid "nor_sand_$1" "$2" "${3:-$tmp/$1.json}"; }
 
-derive valid 'm.update({"strain": "small", "overconsolidation_ratio": 1.5, "critical_state_reference_pressure": 1e3, "initial_reference_pressure": 2e3, "dilatancy_cutoff_start": 1.0, "dilatancy_cutoff_end": 1.5, "gas_volume_ratio": 1.6})'
+derive valid 'm.update({"strain": "small", "overconsolidation_ratio": 1.5, "critical_state_reference_pressure": 1e3, "initial_reference_pressure": 2e3, "dilatancy_cutoff_start": 1.0, "dilatancy_cutoff_end": 1.5, "gas_volume_ratio": 1.6, "initial_yield_surface": "through_stress"})'
 "$solve" validate "$tmp/valid.json" > /dev/null 2> "$tmp/err"
 rc=$?
 check validate_nor_sand_case_exits_0 $rc "exit $rc: $(head -c 300 "$tmp/err")"
@@ -37,6 +37,7 @@ derive reference_specific_volume_string 'm["reference_specific_volume"] = "1.892
 derive ocr_below_one 'm["overconsolidation_ratio"] = 0.8'
 derive cutoff_end_before_start 'm.update({"dilatancy_cutoff_start": 1.5, "dilatancy_cutoff_end": 1.0})'
 derive gas_ratio_one 'm["gas_volume_ratio"] = 1'
+derive yield_surface_unknown 'm["initial_yield_surface"] = "outside"'
 derive youngs_modulus_on_nor_sand 'm["youngs_modulus"] = 1e7'
 derive nor_sand_key_on_mohr_coulomb 'm.clear(); m.update({"name": "soil", "density": 2650, "model": "mohr_coulomb", "youngs_modulus": 1e7, "poisson_ratio": 0.3, "cohesion": 1e4, "friction_angle": 30, "dilation_angle": 0, "shear_modulus": 4e6})'
 
@@ -54,6 +55,7 @@ bad reference_specific_volume_string /materials/0/reference_specific_volume
 bad ocr_below_one /materials/0/overconsolidation_ratio
 bad cutoff_end_before_start /materials/0/dilatancy_cutoff_end
 bad gas_ratio_one /materials/0/gas_volume_ratio
+bad yield_surface_unknown /materials/0/initial_yield_surface
 bad youngs_modulus_on_nor_sand /materials/0/youngs_modulus
 bad nor_sand_key_on_mohr_coulomb /materials/0/shear_modulus
 

@@ -13,6 +13,8 @@
  *     below, inside and beyond the cut-off, and the state it uses switches where Eq. 92 says;
  *   - the gas-like state of Eqs. 93-94 on both sides of v_crit, and the restart from Be = I;
  *   - 000 Eq. 113 for the initial image pressure, and material_reset_reference (App. B.4);
+ *   - initial_yield_surface "through_stress": the surface through the loaded stress, which a zero
+ *     step then keeps, where the default tip returns it;
  *   - the element cases: App. B.3's undrained tests reach the critical state (q/p within
  *     CS_RATIO_TOLERANCE of M, |psi| <= CS_PSI_TOLERANCE), drained tests keep dq = 3 dp and
  *     dilate (dense) or contract (loose).
@@ -510,6 +512,67 @@ static void check_initialisation(void)
 	CHECK(ok, "nor_sand_initialisation_eq113_and_reset", "see INFO");
 }
 
+/* initial_yield_surface "through_stress" against the default "tip", on what 000 App. B.4's elastic
+ * gravity loading leaves in the landslide slopes: Table 5's G = 40 MPa against K = p / kappa = 1 MPa
+ * at p0 = 2 kPa carries a vertical load almost wholly in shear (q/p 1.67 on average at the end of the
+ * ramp). After the reset the surface passes through that stress (F = 0 to YIELD_TOLERANCE) and a zero
+ * step keeps it (to 1e-12 of p, no plastic strain); with the tip the same zero step returns the point
+ * to q/p below 0.1. Points given an initial stress are treated alike; one with a stress ratio beyond
+ * M / N, which no surface reaches, gets a finite image pressure and stays outside, for its first
+ * plastic step to return. */
+static void check_initial_surface_through_stress(void)
+{
+	static const double I[4] = { 1, 0, 0, 1 };
+	double eta_kept = 0, eta_tip = 0, kept_change = 0, F_reset = 0, F_init = 0;
+	int ok = 1;
+	for (int through = 1; through >= 0; through--) {
+		struct material m = table5_landslide();
+		m.ns.through_stress = through;
+		double stress[4] = { 0, 0, 0, 0 }, Be[4], state[STATE_MAX], plastic = 0;
+		nor_sand_init_state(&m, stress, Be, state);
+		double dF[4] = { 1.0, 0.0, 0.0, 0.9999 };   /* one-dimensional compression, plane strain */
+		struct poro_error err = {0};
+		struct stress_update u = { .dF = dF, .J = 0.9999, .stress = stress, .Be = Be, .state = state,
+					   .plastic_strain = &plastic, .elastic_only = 1 };
+		ok &= material_update(&m, &u, &err) == PORO_OK;
+		double p, q, before[4];
+		invariants(stress, &p, &q);
+		memcpy(before, stress, sizeof before);
+		material_reset_reference(&m, stress, Be, u.J, state);
+		if (through)
+			F_reset = yield_value(&m, u.J * p, u.J * q, state[NOR_SAND_IMAGE_PRESSURE]) / (u.J * (p + q));
+		u.dF = I, u.elastic_only = 0;   /* the first step with plasticity, no motion (J stays) */
+		ok &= material_update(&m, &u, &err) == PORO_OK;
+		double p1, q1, change = 0;
+		invariants(stress, &p1, &q1);
+		for (int k = 0; k < 4; k++)
+			change = fmax(change, fabs(stress[k] - before[k]) / p);
+		if (through) {
+			eta_kept = q1 / p1, kept_change = change;
+			ok &= change <= 1e-12 && plastic == 0.0 && q / p > m.ns.M;
+		} else {
+			eta_tip = q1 / p1;
+			ok &= eta_tip < 0.1;
+		}
+	}
+	/* an initial stress beyond M / N = 10, and one within it, set directly */
+	struct material m = table5_landslide();
+	m.ns.through_stress = 1;
+	double far[4] = { 9.5e3, -30e3, 0, 9.5e3 }, near[4] = { -2e3, -6e3, 0, -2e3 }, Be[4], state[STATE_MAX], p, q;
+	nor_sand_init_state(&m, near, Be, state);
+	invariants(near, &p, &q);
+	F_init = yield_value(&m, p, q, state[NOR_SAND_IMAGE_PRESSURE]) / (p + q);
+	nor_sand_init_state(&m, far, Be, state);
+	invariants(far, &p, &q);
+	const int far_outside = isfinite(state[NOR_SAND_IMAGE_PRESSURE]) && q / p > m.ns.M / m.ns.N &&
+				yield_value(&m, p, q, state[NOR_SAND_IMAGE_PRESSURE]) > 0;
+	ok &= fabs(F_reset) <= YIELD_TOLERANCE && fabs(F_init) <= YIELD_TOLERANCE && far_outside;
+	printf("INFO nor_sand_initial_surface: after the reset F / (p + q) %.2g; first plastic step: stress change "
+	       "%.2g of p and q/p %.3f (through_stress), q/p %.3f (tip); initial stress F / (p + q) %.2g\n",
+	       F_reset, kept_change, eta_kept, eta_tip, F_init);
+	CHECK(ok, "nor_sand_initial_surface_through_stress_keeps_the_loaded_stress", "see INFO");
+}
+
 /* A trial at p_tr = p0 exp(-ev / kappa) with a shear q_tr = 3 G es far beyond the surface, from image
  * pressure pi_n: the return ends at q = 0 with the image pressure solving Eq. 92's backward Euler
  * hardening R2 = pi - pi_n - h es (g(psi_i) p - pi) = 0, at the tip p = c_N pi when that is at most
@@ -626,6 +689,7 @@ int main(void)
 	check_gas(&fin);
 	check_specific_volume_from_J_v(&fin);
 	check_initialisation();
+	check_initial_surface_through_stress();
 	check_undrained(100);
 	check_undrained(200);
 	check_undrained(300);
