@@ -38,20 +38,14 @@
  * out and in (check_seedings): one seeding moves the loose run-outs by more than double and single
  * point differ, so Fig. 10's "similar" is asked of the pair's mean run-outs. At paper size these
  * are eight more runs, each as long as one of the cases' own.
- * The four runs of a set go side by side in child processes, one per OpenMP thread, each on one
- * thread (run_four): the same figures to the last digit, sooner (the reduced part: 230 s against
- * 349 s on two cores, measured 2026-12-03).
  * Also (make test): the dense single-point slope with the weak free-surface condition runs to the
  * end (a regression test of its mass floor, free_surface.c); and the loose pair with the water held
  * in the soil (k = 5e-5 m/s) should agree, which it does not (a known failure, check_nearly_undrained).
  */
-#include <errno.h>
 #include <math.h>
 #include <omp.h>
 #include <stdlib.h>
 #include <string.h>
-#include <sys/wait.h>
-#include <unistd.h>
 
 #include "../harness.h"
 #include "case.h"
@@ -219,102 +213,14 @@ struct known_failures {
 /* Runs the four cases (CASE_FILES' order) into r, each reported with `suffix` after its label.
  * Returns whether all ran to their end; *mass becomes the largest relative mass error (it starts
  * at the caller's value). */
-/* What one call of run_cases runs its four cases with. */
-struct run_settings {
-	double h;
-	int ppc;
-	double paper_end;
-	enum change change;
-	double face_shift;
-};
-
-static struct landslide_run run_case(int k, const struct run_settings *set)
-{
-	return run_landslide(CASE_FILES[k], set->h, set->ppc, set->paper_end, set->change, set->face_shift);
-}
-
-/* Starts case k in a child process on one thread, which writes its landslide_run to a pipe and
- * exits. Returns the child's pid and sets *fd to the pipe's read end, or returns -1. */
-static pid_t start_child(int k, const struct run_settings *set, int *fd)
-{
-	int p[2];
-	fflush(stdout);   /* the child must not print the parent's buffered lines again */
-	if (pipe(p) != 0)
-		return -1;
-	const pid_t pid = fork();
-	if (pid == 0) {
-		close(p[0]);
-		omp_set_num_threads(1);
-		const struct landslide_run mine = run_case(k, set);
-		const int sent = write(p[1], &mine, sizeof mine) == (ssize_t)sizeof mine;
-		fflush(stdout);
-		_exit(sent ? 0 : 1);
-	}
-	close(p[1]);
-	if (pid < 0) {
-		close(p[0]);
-		return -1;
-	}
-	*fd = p[0];
-	return pid;
-}
-
-/* Waits for one child of pid[] and reads its run into r[]; a child that sent nothing (it died)
- * leaves a failed run. Returns how many children were collected. */
-static int collect_child(pid_t pid[4], const int fd[4], struct landslide_run r[4])
-{
-	int status = 0, collected = 0;
-	pid_t child;
-	do
-		child = wait(&status);
-	while (child < 0 && errno == EINTR);
-	for (int k = 0; k < 4; k++) {
-		if (pid[k] <= 0 || (child > 0 && pid[k] != child))
-			continue;   /* with no child left to wait for (child < 0), every pending run fails */
-		if (child < 0 || read(fd[k], &r[k], sizeof r[k]) != (ssize_t)sizeof r[k]) {
-			memset(&r[k], 0, sizeof r[k]);
-			printf("INFO the run of %s ended without a result (wait status %d)\n", CASE_FILES[k], status);
-		}
-		close(fd[k]);
-		pid[k] = 0;
-		collected++;
-	}
-	return collected;
-}
-
-/* Runs the four cases as many at a time as OpenMP has threads, each in a child process on one
- * thread. A run is the same at any thread count (docs/performance.md, "Threads"), and one-thread
- * runs side by side finish sooner than the same runs one after another on all the threads.
- * Processes, not threads: HDF5 as Debian builds it is not thread-safe. With one thread, or when
- * no child can be made, a case runs here. */
-static void run_four(const struct run_settings *set, struct landslide_run r[4])
-{
-	const int slots = omp_get_max_threads();
-	pid_t pid[4] = {0};
-	int fd[4] = {-1, -1, -1, -1}, running = 0;
-	memset(r, 0, 4 * sizeof *r);
-	for (int k = 0; k < 4; k++) {
-		if (slots > 1 && running >= slots)
-			running -= collect_child(pid, fd, r);
-		pid[k] = slots > 1 ? start_child(k, set, &fd[k]) : -1;
-		if (pid[k] > 0)
-			running++;
-		else
-			r[k] = run_case(k, set);
-	}
-	while (running > 0)
-		running -= collect_child(pid, fd, r);
-}
-
 static int run_cases(double h, int ppc, double paper_end, enum change change, double face_shift, const char *suffix,
 		     struct landslide_run r[4], double *mass)
 {
 	int all_ok = 1;
-	const struct run_settings set = {h, ppc, paper_end, change, face_shift};
-	run_four(&set, r);
 	for (int k = 0; k < 4; k++) {
 		char label[96];
 		snprintf(label, sizeof label, "%s%s", CASE_LABELS[k], suffix);
+		r[k] = run_landslide(CASE_FILES[k], h, ppc, paper_end, change, face_shift);
 		report(label, h, ppc, &r[k]);
 		all_ok &= r[k].ok;
 		*mass = fmax(*mass, fmax(r[k].soil_mass_error, r[k].water_mass_error));
