@@ -138,8 +138,9 @@ int nor_sand_state_outputs(const struct material *m, const double *state, const 
 
 /* 000 App. B.4, the end of the elastic gravity loading: takes the point's present elastic state as
  * the Nor-Sand reference, p0 = the Kirchhoff mean pressure J p (Eq. 111) and eps_v0^e = tr eps^e =
- * 1/2 ln det Be (Eq. 112), and sets the image pressure from the overconsolidation ratio (Eq. 113);
- * the deviatoric plastic strain restarts at 0. The specific volume keeps v = J v0 with J counted
+ * 1/2 ln det Be (Eq. 112), and sets the image pressure from the overconsolidation ratio (Eq. 113),
+ * or with initial_yield_surface "through_stress" at least the one whose surface passes through the
+ * present stress; the deviatoric plastic strain restarts at 0. The specific volume keeps v = J v0 with J counted
  * from the start, which is Eq. 114. Does nothing for other models. */
 void material_reset_reference(const struct material *m, const double *stress, const double *Be, double J,
 			      double *state);
