@@ -13,6 +13,7 @@ set -u
 build=${1:-build}
 cd "$(dirname "$0")/../.."
 root=$(pwd)
+. tests/service/lib.sh   # check and wait_for; this script starts its own server, so no svc_init
 for b in poro-server poro-worker poro poro-load poro-solve; do
 	if [ ! -x "$build/$b" ]; then
 		echo "FAIL setup: $build/$b is missing"
@@ -32,10 +33,6 @@ solver_pids() {
 	cat "$tmp"/w*.log 2>/dev/null | sed -n "s/.*job ${1:-[0-9]*} attempt [0-9]*: solver started (pid \([0-9]*\).*/\1/p"
 }
 
-check() { # name, status (0 = holds), why
-	if [ "$2" -eq 0 ]; then echo "PASS $1"; else echo "FAIL $1: $3"; fi
-}
-
 # case NAME END: a Terzaghi case ending at END seconds of simulated time
 case_with_end() {
 	python3 - "$root/tests/cases/terzaghi.json" "$tmp/$1.json" "$2" <<'PY'
@@ -44,17 +41,6 @@ c = json.load(open(sys.argv[1]))
 c["time"]["end"] = float(sys.argv[3])
 json.dump(c, open(sys.argv[2], "w"))
 PY
-}
-
-# wait_for SECONDS COMMAND...: polls COMMAND every 0.2 s until it succeeds; 0 if it did
-wait_for() {
-	local limit=$1; shift
-	local end=$(( $(date +%s) + limit ))
-	while [ "$(date +%s)" -lt "$end" ]; do
-		"$@" >/dev/null 2>&1 && return 0
-		sleep 0.2
-	done
-	return 1
 }
 
 state=$tmp/state
