@@ -448,8 +448,6 @@ static double image_from_ocr(const struct nor_sand_parameters *n, double p0)
  * stress is taken just below it, and the first plastic step returns the rest. */
 static double image_through(const struct nor_sand_parameters *n, double p, double q)
 {
-	if (!(p > 0.0))
-		return 0.0;   /* no surface holds a point without pressure: Eq. 113 alone */
 	double eta = q / p;
 	if (n->N == 0.0)
 		return p * exp(eta / n->M - 1.0);
@@ -514,6 +512,8 @@ void material_reset_reference(const struct material *m, const double *stress, co
 	const double kirchhoff = m->strain == STRAIN_FINITE ? J : 1.0;
 	double p = -(stress[0] + stress[1] + stress[3]) / 3.0 * kirchhoff;
 	double det = (Be[0] * Be[1] - Be[2] * Be[2]) * Be[3];
+	if (!(p > 0.0))   /* the elastic law's p = p0 exp(..) is > 0: a stress set from outside, as when stress-free */
+		p = m->ns.p_start;
 	set_reference(m, p, shear_invariant(stress) * kirchhoff, 0.5 * log(det), J, state);
 }
 

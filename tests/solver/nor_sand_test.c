@@ -519,7 +519,8 @@ static void check_initialisation(void)
  * step keeps it (to 1e-12 of p, no plastic strain); with the tip the same zero step returns the point
  * to q/p below 0.1. Points given an initial stress are treated alike; one with a stress ratio beyond
  * M / N, which no surface reaches, gets a finite image pressure and stays outside, for its first
- * plastic step to return. */
+ * plastic step to return. A reset of a tensile stress, which the elastic law never gives, takes the
+ * stress-free point's p0 instead of a logarithm of a negative pressure. */
 static void check_initial_surface_through_stress(void)
 {
 	static const double I[4] = { 1, 0, 0, 1 };
@@ -566,10 +567,16 @@ static void check_initial_surface_through_stress(void)
 	invariants(far, &p, &q);
 	const int far_outside = isfinite(state[NOR_SAND_IMAGE_PRESSURE]) && q / p > m.ns.M / m.ns.N &&
 				yield_value(&m, p, q, state[NOR_SAND_IMAGE_PRESSURE]) > 0;
-	ok &= fabs(F_reset) <= YIELD_TOLERANCE && fabs(F_init) <= YIELD_TOLERANCE && far_outside;
+	double tensile[4] = { 1e3, 1e3, 0, 1e3 }, Be_unit[4] = { 1, 1, 0, 1 };
+	material_reset_reference(&m, tensile, Be_unit, 1.0, state);
+	const int tensile_finite = state[NOR_SAND_REFERENCE_PRESSURE] == m.ns.p_start &&
+				   isfinite(state[NOR_SAND_IMAGE_PRESSURE]) && isfinite(state[NOR_SAND_CUTOFF_STATE]) &&
+				   isfinite(state[NOR_SAND_STATE_PARAMETER]);
+	ok &= fabs(F_reset) <= YIELD_TOLERANCE && fabs(F_init) <= YIELD_TOLERANCE && far_outside && tensile_finite;
 	printf("INFO nor_sand_initial_surface: after the reset F / (p + q) %.2g; first plastic step: stress change "
-	       "%.2g of p and q/p %.3f (through_stress), q/p %.3f (tip); initial stress F / (p + q) %.2g\n",
-	       F_reset, kept_change, eta_kept, eta_tip, F_init);
+	       "%.2g of p and q/p %.3f (through_stress), q/p %.3f (tip); initial stress F / (p + q) %.2g; "
+	       "reset of a tensile stress finite: %s\n",
+	       F_reset, kept_change, eta_kept, eta_tip, F_init, tensile_finite ? "yes" : "no");
 	CHECK(ok, "nor_sand_initial_surface_through_stress_keeps_the_loaded_stress", "see INFO");
 }
 
