@@ -25,6 +25,8 @@ LIBPORO    = $(BUILD)/libporo.a
 POROSOLVE  = $(BUILD)/poro-solve
 TEST_SRC   = $(wildcard tests/solver/*_test.c tests/verify/*_test.c)
 TEST_BIN   = $(TEST_SRC:%.c=$(BUILD)/%)
+# Tests of common/ (the service's shared code) link that code alone, not the solver.
+COMMON_TEST_BIN = $(patsubst %.c,$(BUILD)/%,$(wildcard tests/common/*_test.c))
 BENCH_SRC  = $(wildcard bench/*_bench.c)
 BENCH_BIN  = $(BENCH_SRC:%.c=$(BUILD)/%)
 TOOLS      = $(BUILD)/terzaghi-error
@@ -49,7 +51,7 @@ deps:
 all: deps
 	@$(MAKE) --no-print-directory build-all
 
-build-all: $(POROSOLVE) $(TEST_BIN) $(BENCH_BIN) $(TOOLS) $(SERVICE)
+build-all: $(POROSOLVE) $(TEST_BIN) $(COMMON_TEST_BIN) $(BENCH_BIN) $(TOOLS) $(SERVICE)
 
 run: deps
 	@$(MAKE) --no-print-directory build-all
@@ -85,6 +87,9 @@ $(BUILD)/tools/terzaghi_error.o: tests/verify/analytic.h
 
 $(BUILD)/tests/%: $(BUILD)/tests/%.o $(LIBPORO)
 	$(CC) $(LDFLAGS) $^ $(LDLIBS) -o $@
+
+$(BUILD)/tests/common/%: $(BUILD)/tests/common/%.o $(COMMON_OBJ)
+	$(CC) $(LDFLAGS) $^ $(SVC_LIBS) -o $@
 
 $(BUILD)/bench/%: $(BUILD)/bench/%.o $(LIBPORO)
 	$(CC) $(LDFLAGS) $^ $(LDLIBS) -o $@

@@ -16,7 +16,7 @@ log="$build/test-output.txt"
 
 programs=()
 if [ "$mode" = test ]; then
-	for t in "$build"/tests/solver/*_test "$build"/tests/verify/*_test; do [ -x "$t" ] && programs+=("$t"); done
+	for t in "$build"/tests/common/*_test "$build"/tests/solver/*_test "$build"/tests/verify/*_test; do [ -x "$t" ] && programs+=("$t"); done
 	for t in tests/cli/*_test.sh tests/service/*_test.sh; do [ -f "$t" ] && programs+=("bash $t $build"); done
 	# every poro-server the service tests start logs its requests here; the coverage check reads it
 	export SVC_ROUTES_LOG="$PWD/$build/service-routes.log"
