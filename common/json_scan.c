@@ -31,6 +31,8 @@ void json_scan_init(struct json_scan *s, const struct json_limits *limits)
 	if (s->limits.max_depth > JSON_SCAN_DEPTH_MAX || s->limits.max_depth <= 0)
 		s->limits.max_depth = JSON_SCAN_DEPTH_MAX;
 	s->state = S_VALUE;
+	s->line = 1;
+	s->column = 1;
 }
 
 static int fail(struct json_scan *s, enum json_scan_verdict verdict, unsigned char c)
@@ -42,19 +44,21 @@ static int fail(struct json_scan *s, enum json_scan_verdict verdict, unsigned ch
 		snprintf(seen, sizeof seen, "0x%02x", c);
 	switch (verdict) {
 	case JSON_SCAN_TOO_DEEP:
-		snprintf(s->error, sizeof s->error, "JSON nested deeper than %d levels at byte %lld",
-			 s->limits.max_depth, s->offset);
+		snprintf(s->error, sizeof s->error, "JSON nested deeper than %d levels at line %lld column %lld",
+			 s->limits.max_depth, s->line, s->column);
 		break;
 	case JSON_SCAN_TOO_MANY:
-		snprintf(s->error, sizeof s->error, "JSON holds more than %lld values (keys included) at byte %lld",
-			 s->limits.max_values, s->offset);
+		snprintf(s->error, sizeof s->error,
+			 "JSON holds more than %lld values (keys included) at line %lld column %lld",
+			 s->limits.max_values, s->line, s->column);
 		break;
 	case JSON_SCAN_TOKEN_TOO_LONG:
-		snprintf(s->error, sizeof s->error, "JSON string or number longer than %zu bytes at byte %lld",
-			 s->limits.max_token_bytes, s->offset);
+		snprintf(s->error, sizeof s->error, "JSON string or number longer than %zu bytes at line %lld column %lld",
+			 s->limits.max_token_bytes, s->line, s->column);
 		break;
 	default:
-		snprintf(s->error, sizeof s->error, "invalid JSON at byte %lld: unexpected %s", s->offset, seen);
+		snprintf(s->error, sizeof s->error, "invalid JSON at line %lld column %lld: unexpected %s", s->line,
+			 s->column, seen);
 		break;
 	}
 	s->verdict = verdict;
@@ -320,6 +324,12 @@ int json_scan_feed(struct json_scan *s, const char *data, size_t size)
 		if (take(s, (unsigned char)data[i]))
 			return -1;
 		s->offset++;
+		if (data[i] == '\n') {
+			s->line++;
+			s->column = 1;
+		} else {
+			s->column++;
+		}
 	}
 	return 0;
 }
@@ -332,8 +342,8 @@ int json_scan_finish(struct json_scan *s)
 					 s->state == S_FRACTION || s->state == S_EXPONENT);
 	if (complete)
 		return 0;
-	snprintf(s->error, sizeof s->error, "invalid JSON: the text ends at byte %lld inside %s", s->offset,
-		 s->values == 0 ? "nothing (no value)" : "a value");
+	snprintf(s->error, sizeof s->error, "invalid JSON: the text ends at line %lld column %lld %s", s->line,
+		 s->column, s->values == 0 ? "before any value" : "inside a value");
 	s->verdict = JSON_SCAN_SYNTAX;
 	s->state = S_FAILED;
 	return -1;

@@ -43,6 +43,7 @@ struct json_scan {
 	long long values;
 	size_t token;                 /* bytes of the current string or number */
 	long long offset;             /* bytes consumed so far */
+	long long line, column;       /* of the next byte, from 1, as jansson counts them */
 	unsigned char kinds[JSON_SCAN_DEPTH_MAX / 8]; /* bit per level: 1 object, 0 array */
 	char error[160];              /* what was wrong and at which byte, once verdict != OK */
 };

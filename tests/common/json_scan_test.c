@@ -151,6 +151,13 @@ static void random_mutations(void)
 
 static void limits(void)
 {
+	/* positions count lines and columns as jansson does, from 1 */
+	const char *two_lines = "{\"a\": 1,\n \"b\": }";
+	struct json_scan p;
+	int bad = scan(two_lines, strlen(two_lines), 0, &GENEROUS, &p);
+	CHECK(bad != 0 && strstr(p.error, "line 2 column 7: unexpected '}'"), "json_scan_names_line_and_column",
+	      "'%s'", p.error);
+
 	struct json_scan s;
 	char deep[200];
 	for (int i = 0; i < 100; i++)
@@ -161,7 +168,7 @@ static void limits(void)
 	lim.max_depth = 99;
 	int over = scan(deep, sizeof deep, 0, &lim, &s);
 	CHECK(at_limit == 0 && over != 0 && s.verdict == JSON_SCAN_TOO_DEEP && s.offset == 99 &&
-		      strstr(s.error, "deeper than 99 levels at byte 99"),
+		      strstr(s.error, "deeper than 99 levels at line 1 column 100"),
 	      "json_scan_depth_limit", "at limit %d, over %d, verdict %d, offset %lld, '%s'", at_limit, over, s.verdict,
 	      s.offset, s.error);
 
@@ -187,7 +194,7 @@ static void limits(void)
 	/* a refused text stays refused: later pieces are not looked at */
 	json_scan_init(&s, &GENEROUS);
 	int first = json_scan_feed(&s, "[1,}", 4), again = json_scan_feed(&s, "1]", 2);
-	CHECK(first != 0 && again != 0 && json_scan_finish(&s) != 0 && strstr(s.error, "byte 3: unexpected '}'"),
+	CHECK(first != 0 && again != 0 && json_scan_finish(&s) != 0 && strstr(s.error, "line 1 column 4: unexpected '}'"),
 	      "json_scan_failure_sticks", "first %d, again %d, '%s'", first, again, s.error);
 }
 
