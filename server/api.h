@@ -36,7 +36,8 @@ void admin_users_create(struct request *r);
 void admin_tokens_create(struct request *r);
 
 /* ---- request-body helpers (api_json.c) ---- */
-/* The body as a JSON object; NULL after replying 400 invalid_json (with jansson's line and column). */
+/* The body as a JSON object; NULL after replying 400 invalid_json (with jansson's line and column),
+ * or 503 when jansson runs out of memory. The body's syntax has been checked by http.c already. */
 json_t *api_body_object(struct request *r);
 /* Refuses keys of obj not in the NULL-terminated list: 0, or -1 after replying 422 naming the key. */
 int api_known_keys(struct request *r, json_t *obj, const char *const *keys);

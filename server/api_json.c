@@ -18,6 +18,21 @@ json_t *api_body_object(struct request *r)
 	}
 	json_t *v = json_loadb(r->body, r->body_size, JSON_REJECT_DUPLICATES, &je);
 	if (!v) {
+		/* http.c has already checked the body's syntax while it streamed in (json_scan.h). What
+		 * the scan does not check is the client's error: UTF-8, \u escapes of lone surrogates,
+		 * \u0000, duplicate keys, numbers beyond 64 bits. Any other failure is jansson running
+		 * out of memory midway, which it reports as whatever syntax error the half-read token
+		 * makes ("invalid token", "string or '}' expected", line -1). */
+		enum json_error_code code = json_error_code(&je);
+		int clients = code == json_error_invalid_utf8 || code == json_error_null_character ||
+			      code == json_error_duplicate_key || code == json_error_numeric_overflow ||
+			      (code == json_error_invalid_syntax && strncmp(je.text, "invalid Unicode", 15) == 0);
+		if (!clients) {
+			reply_header(r, "Retry-After", "1");
+			reply_fail(r, API_UNAVAILABLE, "", "no memory to read a request body of %zu bytes: retry later",
+				   r->body_size);
+			return NULL;
+		}
 		reply_fail(r, API_INVALID_JSON, "", "request body is not valid JSON: line %d column %d: %s", je.line,
 			   je.column, je.text);
 		return NULL;

@@ -1,29 +1,42 @@
 /*
- * http.c - the HTTP front end on libmicrohttpd (the only file that includes microhttpd.h): the
- * route table, authentication and roles, request-body limits, and replies (http.h).
+ * http.c - the HTTP engine on libmicrohttpd (the only file that includes microhttpd.h): the route
+ * table, authentication and roles, request-body limits, per-token limits, and replies (http.h).
  *
  * Threads: MHD_USE_THREAD_PER_CONNECTION, so a long-poll claim or a followed log blocks only its
- * own connection. A request goes through: route match (404, or 405 with Allow), bearer token
- * (401 with WWW-Authenticate), role (403), Content-Length against the limit (413 before any byte
- * of the body is read), then the body is accumulated (JSON routes, limit enforced again while
- * streaming chunked bodies: the rest is discarded and 413 answered) or streamed to the route's
- * upload callbacks, and finally the handler runs.
+ * own connection. libmicrohttpd has no listening socket of its own: the front door
+ * (front_door.h) accepts connections, waits for and checks each first request head, and hands the
+ * connection over with MHD_add_connection; libmicrohttpd's connection hooks keep the front door
+ * told of each connection's state, so it can time out idle ones and slow bodies.
+ *
+ * A request goes through: route match (404, or 405 with Allow; HEAD is taken as GET), bearer token
+ * (401 with WWW-Authenticate), role (403), the token's requests in progress (429), Content-Length
+ * against the route's limit (413 before any byte of the body is read), then the body is
+ * accumulated (JSON routes: the limit enforced again while streaming chunked bodies, and the JSON
+ * checked while it streams, common/json_scan.h; a body that breaks either is discarded to its end
+ * and answered 413 or 400) or streamed to the route's upload callbacks, and finally the handler
+ * runs (a submission after waiting for its turn, request_gate.h).
  *
  * The URL is not unescaped by libmicrohttpd (UNESCAPE_CALLBACK is the identity): path elements
  * and query values are decoded here and in handlers, one element at a time, so an encoded slash
  * or NUL can never change how a path splits.
+ *
+ * Out of memory: a request that cannot get memory for its body, its tree or its answer is answered
+ * 503 unavailable (the answer to that is a static text), never a crash; the store's writes are
+ * transactions, so a failed one leaves nothing half done.
  */
 #include "api.h"
+#include "front_door.h"
 #include "http.h"
 #include "metrics.h"
+#include "request_gate.h"
 #include "store.h"
 
 #include "digest.h"
+#include "json_scan.h"
 
-#include <arpa/inet.h>
 #include <microhttpd.h>
-#include <netdb.h>
 #include <errno.h>
+#include <malloc.h>
 #include <stdarg.h>
 #include <stdio.h>
 #include <time.h>
@@ -34,40 +47,68 @@
 #include <unistd.h>
 
 #define USER_ROLES (ROLE_USER | ROLE_ADMIN)
-#define DRAIN_FACTOR 4                    /* bytes discarded after a 413 before closing: x limit */
-#define CONNECTION_TIMEOUT_SECONDS 120    /* idle keep-alive connections */
+#define DRAIN_FACTOR 4                    /* upload bytes discarded after a 413 before closing: x limit */
+#define CONNECTION_TIMEOUT_SECONDS 60     /* libmicrohttpd's own limit on a silent connection */
+#define CONNECTION_MEMORY 65536           /* libmicrohttpd's per-connection pool: holds a head of
+					   * REQUEST_HEAD_MAX with room to spare */
+#define THREAD_STACK_BYTES (2u << 20)     /* per connection thread; enough for the deepest handler */
 #define STREAM_BLOCK 16384
+#define TRIM_AFTER_BYTES (1 << 20)        /* a JSON body this large: return freed memory to the system */
+
+/* The body limits of each kind of route (enum body_kind); --max-body-bytes caps the JSON ones. */
+#define SMALL_BODY_MAX (64 * 1024)
+#define LOG_BODY_MAX (2 * 1024 * 1024)    /* a worker's 256 KiB chunk, JSON-escaped at worst 6 times */
+static const struct json_limits SMALL_JSON = { .max_depth = 16, .max_values = 4096, .max_token_bytes = 16384 };
+static const struct json_limits LOG_JSON = { .max_depth = 4, .max_values = 16, .max_token_bytes = LOG_BODY_MAX };
+#define CASE_DEPTH_MAX 32                 /* a case nests about 6 deep */
+#define CASE_TOKEN_MAX 65536              /* names, titles, units: far below */
 
 static const struct route ROUTES[] = {
-	{ "POST", "/v1/jobs", USER_ROLES, jobs_submit, 0, 0, 0, 0 },
-	{ "GET", "/v1/jobs", USER_ROLES, jobs_list, 0, 0, 0, 0 },
-	{ "GET", "/v1/jobs/{id}", USER_ROLES, jobs_show, 0, 0, 0, 0 },
-	{ "POST", "/v1/jobs/{id}/cancel", USER_ROLES, jobs_cancel, 0, 0, 0, 0 },
-	{ "GET", "/v1/jobs/{id}/log", USER_ROLES, logs_get, 0, 0, 0, 0 },
-	{ "GET", "/v1/jobs/{id}/files/{name}", USER_ROLES, files_get, 0, 0, 0, 0 },
-	{ "GET", "/v1/jobs/{id}/probes", USER_ROLES, jobs_probes, 0, 0, 0, 0 },
-	{ "POST", "/v1/worker/claim", ROLE_WORKER, worker_claim, 0, 0, 0, 0 },
-	{ "POST", "/v1/worker/jobs/{id}/heartbeat", ROLE_WORKER, worker_heartbeat, 0, 0, 0, 0 },
-	{ "POST", "/v1/worker/jobs/{id}/log", ROLE_WORKER, worker_log, 0, 0, 0, 0 },
-	{ "POST", "/v1/worker/jobs/{id}/finish", ROLE_WORKER, worker_finish, 0, 0, 0, 0 },
-	{ "PUT", "/v1/worker/jobs/{id}/files/{name}", ROLE_WORKER, NULL, files_upload_begin, files_upload_data,
-	  files_upload_end, files_upload_abort },
-	{ "GET", "/v1/worker/jobs/{id}/files/{name}", ROLE_WORKER, worker_file_get, 0, 0, 0, 0 },
-	{ "GET", "/healthz", 0, admin_healthz, 0, 0, 0, 0 },
-	{ "GET", "/metrics", ROLE_WORKER | ROLE_ADMIN, admin_metrics, 0, 0, 0, 0 },
-	{ "POST", "/v1/users", ROLE_ADMIN, admin_users_create, 0, 0, 0, 0 },
-	{ "POST", "/v1/tokens", ROLE_ADMIN, admin_tokens_create, 0, 0, 0, 0 },
+	{ "POST", "/v1/jobs", USER_ROLES, BODY_CASE, jobs_submit, 0, 0, 0, 0 },
+	{ "GET", "/v1/jobs", USER_ROLES, BODY_SMALL, jobs_list, 0, 0, 0, 0 },
+	{ "GET", "/v1/jobs/{id}", USER_ROLES, BODY_SMALL, jobs_show, 0, 0, 0, 0 },
+	{ "POST", "/v1/jobs/{id}/cancel", USER_ROLES, BODY_SMALL, jobs_cancel, 0, 0, 0, 0 },
+	{ "GET", "/v1/jobs/{id}/log", USER_ROLES, BODY_SMALL, logs_get, 0, 0, 0, 0 },
+	{ "GET", "/v1/jobs/{id}/files/{name}", USER_ROLES, BODY_SMALL, files_get, 0, 0, 0, 0 },
+	{ "GET", "/v1/jobs/{id}/probes", USER_ROLES, BODY_SMALL, jobs_probes, 0, 0, 0, 0 },
+	{ "POST", "/v1/worker/claim", ROLE_WORKER, BODY_SMALL, worker_claim, 0, 0, 0, 0 },
+	{ "POST", "/v1/worker/jobs/{id}/heartbeat", ROLE_WORKER, BODY_SMALL, worker_heartbeat, 0, 0, 0, 0 },
+	{ "POST", "/v1/worker/jobs/{id}/log", ROLE_WORKER, BODY_LOG, worker_log, 0, 0, 0, 0 },
+	{ "POST", "/v1/worker/jobs/{id}/finish", ROLE_WORKER, BODY_SMALL, worker_finish, 0, 0, 0, 0 },
+	{ "PUT", "/v1/worker/jobs/{id}/files/{name}", ROLE_WORKER, BODY_UPLOAD, NULL, files_upload_begin,
+	  files_upload_data, files_upload_end, files_upload_abort },
+	{ "GET", "/v1/worker/jobs/{id}/files/{name}", ROLE_WORKER, BODY_SMALL, worker_file_get, 0, 0, 0, 0 },
+	{ "GET", "/healthz", 0, BODY_SMALL, admin_healthz, 0, 0, 0, 0 },
+	{ "GET", "/metrics", ROLE_WORKER | ROLE_ADMIN, BODY_SMALL, admin_metrics, 0, 0, 0, 0 },
+	{ "POST", "/v1/users", ROLE_ADMIN, BODY_SMALL, admin_users_create, 0, 0, 0, 0 },
+	{ "POST", "/v1/tokens", ROLE_ADMIN, BODY_SMALL, admin_tokens_create, 0, 0, 0, 0 },
 };
 #define ROUTE_COUNT (sizeof ROUTES / sizeof ROUTES[0])
+
+/* What http_start makes: the engine, its front door and the per-token limits. */
+struct http {
+	struct server *srv;
+	struct MHD_Daemon *daemon;
+	struct front_door *door;
+	struct request_gate *gate;
+};
 
 /* Per-request state beyond struct request. */
 struct exchange {
 	struct request req;
+	struct http *http;
+	struct door_conn *door;       /* the front door's record of the connection, or NULL */
 	int queued;                   /* a response was queued */
 	int refused;                  /* replied before the body: discard what comes */
 	int too_large;
+	int out_of_memory;            /* the body could not be kept: discard the rest, answer 503 */
 	int upload_failed;            /* upload_data replied: discard the rest */
 	int upload_started;
+	int token_counted;            /* the gate counts this request against token_hash */
+	int submission;               /* holds a submission's turn */
+	char token_hash[DIGEST_HEX_SIZE];
+	struct json_scan scan;        /* of a JSON body as it streams in */
+	int scan_failed;              /* the scan refused the body: discard the rest */
 	long long received;
 	size_t capacity;
 	struct timespec started;      /* arrival, for the access log */
@@ -182,10 +223,11 @@ void reply_json(struct request *r, int status, json_t *body)
 {
 	char *text = body ? json_dumps(body, JSON_COMPACT) : NULL;
 	json_decref(body);
-	if (!text) {
-		reply_text(r, 500, "application/json", strdup("{\"error\":{\"code\":\"internal\",\"message\":"
-							      "\"cannot encode the answer\",\"field\":null}}"), 0);
-		r->reply.size = strlen(r->reply.body);
+	if (!text) { /* only allocation fails here: the answer itself, or the tree it was made of */
+		static const char out_of_memory[] = "{\"error\":{\"code\":\"unavailable\",\"message\":"
+						    "\"the server is out of memory: retry later\",\"field\":null}}\n";
+		char *copy = strdup(out_of_memory);
+		reply_text(r, 503, "application/json", copy, copy ? strlen(copy) : 0);
 		return;
 	}
 	size_t n = strlen(text);
@@ -267,8 +309,10 @@ static enum MHD_Result queue_reply(struct exchange *x)
 	struct MHD_Response *resp;
 	if (rep->stream) {
 		struct reply *moved = malloc(sizeof *moved);
-		if (!moved)
+		if (!moved) {
+			front_door_answer_unavailable(x->http->door, x->door);
 			return MHD_NO;
+		}
 		*moved = *rep;
 		rep->stream = NULL; /* now owned by the response */
 		resp = MHD_create_response_from_callback(MHD_SIZE_UNKNOWN, STREAM_BLOCK, stream_adapter, moved,
@@ -286,8 +330,10 @@ static enum MHD_Result queue_reply(struct exchange *x)
 		if (resp)
 			rep->body = NULL;
 	}
-	if (!resp)
+	if (!resp) {
+		front_door_answer_unavailable(x->http->door, x->door);
 		return MHD_NO;
+	}
 	if (rep->content_type)
 		MHD_add_response_header(resp, MHD_HTTP_HEADER_CONTENT_TYPE, rep->content_type);
 	for (int i = 0; i < rep->header_count; i++)
@@ -353,7 +399,8 @@ static int route_request(struct request *r)
 		char *name = NULL;
 		if (!match(ROUTES[i].pattern, r->url, &id, &name))
 			continue;
-		if (strcmp(ROUTES[i].method, r->method) == 0) {
+		const char *method = strcmp(r->method, "HEAD") == 0 ? "GET" : r->method;
+		if (strcmp(ROUTES[i].method, method) == 0) {
 			r->route = &ROUTES[i];
 			r->id = id;
 			r->name = name;
@@ -362,7 +409,8 @@ static int route_request(struct request *r)
 		free(name);
 		if (!strstr(allow, ROUTES[i].method)) {
 			size_t n = strlen(allow);
-			snprintf(allow + n, sizeof allow - n, "%s%s", n ? ", " : "", ROUTES[i].method);
+			int get = strcmp(ROUTES[i].method, "GET") == 0;
+			snprintf(allow + n, sizeof allow - n, "%s%s%s", n ? ", " : "", ROUTES[i].method, get ? ", HEAD" : "");
 		}
 	}
 	if (allow[0]) {
@@ -373,8 +421,9 @@ static int route_request(struct request *r)
 	return reply_fail(r, API_NOT_FOUND, "", "no route '%s'", r->url);
 }
 
-static int authenticate(struct request *r)
+static int authenticate(struct exchange *x)
 {
+	struct request *r = &x->req;
 	if (!r->route->roles)
 		return 0;
 	const char *h = http_header(r, MHD_HTTP_HEADER_AUTHORIZATION);
@@ -398,12 +447,38 @@ static int authenticate(struct request *r)
 	if (!(r->route->roles & r->who.role))
 		return reply_fail(r, API_FORBIDDEN, "Authorization", "role '%s' may not use %s %s",
 				  role_name(r->who.role), r->method, r->route->pattern);
+	int limit;
+	if (request_gate_enter(x->http->gate, hash, r->who.role, &limit) != 0) {
+		reply_header(r, "Retry-After", "1");
+		return reply_fail(r, API_TOO_MANY_REQUESTS, "Authorization",
+				  "the token of '%s' already has %d requests in progress, its limit", r->who.name, limit);
+	}
+	memcpy(x->token_hash, hash, sizeof hash);
+	x->token_counted = 1;
 	return 0;
 }
 
 static long long body_limit(struct request *r)
 {
-	return r->route->upload_data ? r->srv->cfg.max_upload_bytes : r->srv->cfg.max_body_bytes;
+	long long json_max = r->srv->cfg.max_body_bytes;
+	switch (r->route->body) {
+	case BODY_UPLOAD:
+		return r->srv->cfg.max_upload_bytes;
+	case BODY_CASE:
+		return json_max;
+	case BODY_LOG:
+		return json_max < LOG_BODY_MAX ? json_max : LOG_BODY_MAX;
+	default:
+		return json_max < SMALL_BODY_MAX ? json_max : SMALL_BODY_MAX;
+	}
+}
+
+static struct json_limits body_json_limits(struct request *r)
+{
+	if (r->route->body == BODY_CASE)
+		return (struct json_limits){ .max_depth = CASE_DEPTH_MAX, .max_values = r->srv->cfg.max_body_values,
+					     .max_token_bytes = CASE_TOKEN_MAX };
+	return r->route->body == BODY_LOG ? LOG_JSON : SMALL_JSON;
 }
 
 static int check_length(struct request *r)
@@ -420,9 +495,17 @@ static int check_length(struct request *r)
 static enum MHD_Result begin(struct exchange *x)
 {
 	struct request *r = &x->req;
-	if (route_request(r) || authenticate(r) || check_length(r)) {
+	int refused = route_request(r) || authenticate(x) || check_length(r);
+	/* the body (even of a refused request, which is read and discarded) must arrive in time */
+	int uploads = r->route && r->route->body == BODY_UPLOAD;
+	front_door_request_started(x->http->door, x->door, uploads ? 0 : r->srv->cfg.body_timeout_seconds);
+	if (refused) {
 		x->refused = 1;
 		return queue_reply(x);
+	}
+	if (r->route->body != BODY_UPLOAD) {
+		struct json_limits limits = body_json_limits(r);
+		json_scan_init(&x->scan, &limits);
 	}
 	if (r->route->upload_begin) {
 		x->upload_started = 1;
@@ -435,33 +518,68 @@ static enum MHD_Result begin(struct exchange *x)
 	return MHD_YES;
 }
 
+/* A piece of the body: kept (JSON, after the scan), streamed (uploads) or discarded. A discarded
+ * JSON body is read to its end, however long, so that the client gets its answer: the front door
+ * cuts it at the body deadline. A discarded upload is read only up to DRAIN_FACTOR times its limit
+ * (the connection is then closed): it holds a worker token and could go on at full speed. */
 static int take_data(struct exchange *x, const char *data, size_t size)
 {
 	struct request *r = &x->req;
+	int upload = r->route && r->route->body == BODY_UPLOAD;
 	x->received += (long long)size;
-	if (x->refused || x->too_large || x->upload_failed)
-		return x->received > DRAIN_FACTOR * body_limit(r) + (1 << 20) ? -1 : 0;
+	if (x->refused || x->too_large || x->upload_failed || x->scan_failed || x->out_of_memory)
+		return upload && x->received > DRAIN_FACTOR * body_limit(r) + (1 << 20) ? -1 : 0;
 	if (x->received > body_limit(r)) {
 		x->too_large = 1;
 		return 0;
 	}
-	if (r->route->upload_data) {
+	if (upload) {
 		if (r->route->upload_data(r, data, size) != 0)
 			x->upload_failed = 1;
+		return 0;
+	}
+	if (json_scan_feed(&x->scan, data, size) != 0) {
+		x->scan_failed = 1;
+		free(r->body);
+		r->body = NULL;
+		r->body_size = 0;
 		return 0;
 	}
 	if (r->body_size + size + 1 > x->capacity) {
 		size_t want = r->body_size + size + 1;
 		x->capacity = want > 2 * x->capacity ? want : 2 * x->capacity;
 		char *grown = realloc(r->body, x->capacity);
-		if (!grown)
-			return -1;
+		if (!grown) {
+			x->out_of_memory = 1;
+			return 0;
+		}
 		r->body = grown;
 	}
 	memcpy(r->body + r->body_size, data, size);
 	r->body_size += size;
 	r->body[r->body_size] = '\0';
 	return 0;
+}
+
+/* Runs the handler; a submission first waits for its turn among those being validated. */
+static void handle(struct exchange *x)
+{
+	struct request *r = &x->req;
+	if (r->route->body == BODY_CASE) {
+		int running;
+		if (request_gate_submission_enter(x->http->gate, &running) != 0) {
+			reply_header(r, "Retry-After", "1");
+			reply_fail(r, API_UNAVAILABLE, "", "the server is validating %d submissions, its limit, and none "
+				   "ended within %d s: retry later", running, SUBMISSION_WAIT_SECONDS);
+			return;
+		}
+		x->submission = 1;
+	}
+	r->route->handle(r);
+	if (x->submission) {
+		request_gate_submission_leave(x->http->gate);
+		x->submission = 0;
+	}
 }
 
 static enum MHD_Result on_request(void *cls, struct MHD_Connection *connection, const char *url, const char *method,
@@ -471,11 +589,19 @@ static enum MHD_Result on_request(void *cls, struct MHD_Connection *connection, 
 	struct exchange *x = *con_cls;
 	if (!x) {
 		x = calloc(1, sizeof *x);
-		if (!x)
+		if (!x) {
+			const union MHD_ConnectionInfo *info =
+				MHD_get_connection_info(connection, MHD_CONNECTION_INFO_SOCKET_CONTEXT);
+			front_door_answer_unavailable(((struct http *)cls)->door, info ? info->socket_context : NULL);
 			return MHD_NO;
+		}
 		*con_cls = x;
 		clock_gettime(CLOCK_MONOTONIC, &x->started);
-		x->req.srv = cls;
+		x->http = cls;
+		const union MHD_ConnectionInfo *info =
+			MHD_get_connection_info(connection, MHD_CONNECTION_INFO_SOCKET_CONTEXT);
+		x->door = info ? info->socket_context : NULL;
+		x->req.srv = x->http->srv;
 		x->req.connection = connection;
 		x->req.url = url;
 		x->req.method = method;
@@ -489,15 +615,23 @@ static enum MHD_Result on_request(void *cls, struct MHD_Connection *connection, 
 	}
 	if (x->queued)
 		return MHD_YES;
+	front_door_request_handling(x->http->door, x->door);
 	struct request *r = &x->req;
 	if (x->too_large) {
 		reply_reset(&r->reply);
 		reply_fail(r, API_TOO_LARGE, "", "request body exceeds the limit of %lld bytes", body_limit(r));
+	} else if (x->scan_failed) {
+		int syntax = x->scan.verdict == JSON_SCAN_SYNTAX;
+		reply_fail(r, syntax ? API_INVALID_JSON : API_BODY_TOO_COMPLEX, "", "request body %s: %s",
+			   syntax ? "is not valid JSON" : "is beyond this route's limits", x->scan.error);
+	} else if (x->out_of_memory) {
+		reply_header(r, "Retry-After", "1");
+		reply_fail(r, API_UNAVAILABLE, "", "no memory for a request body of %lld bytes: retry later", x->received);
 	} else if (!x->upload_failed) {
 		if (r->route->upload_end)
 			r->route->upload_end(r);
 		else
-			r->route->handle(r);
+			handle(x);
 	}
 	return queue_reply(x);
 }
@@ -510,11 +644,20 @@ static void on_completed(void *cls, struct MHD_Connection *connection, void **co
 		return;
 	if (x->upload_started && x->req.route->upload_abort)
 		x->req.route->upload_abort(&x->req);
+	if (x->token_counted)
+		request_gate_leave(x->http->gate, x->token_hash);
+	front_door_request_ended(x->http->door, x->door);
 	reply_reset(&x->req.reply);
 	free(x->req.body);
 	free(x->req.name);
+	int large = x->req.route && x->req.route->body != BODY_UPLOAD && x->received >= TRIM_AFTER_BYTES;
 	free(x);
 	*con_cls = NULL;
+	/* the tree of a large body is freed in thousands of small pieces that glibc keeps for reuse:
+	 * give them back, or the server's memory stays at its peak (and new threads may find no
+	 * address space for their stacks) */
+	if (large)
+		malloc_trim(0);
 }
 
 /* The identity: decoding is done per path element (see the top of this file). */
@@ -523,76 +666,84 @@ static size_t no_unescape(void *cls, struct MHD_Connection *c, char *s)
 	return strlen(s);
 }
 
-/* ---- daemon ---- */
+/* ---- engine ---- */
 
-static int split_listen(const char *listen, char *host, size_t host_size, char *port, size_t port_size)
+/* libmicrohttpd took (or let go of) a connection the front door handed over. */
+static void on_connection(void *cls, struct MHD_Connection *connection, void **socket_context,
+			  enum MHD_ConnectionNotificationCode code)
 {
-	const char *colon = strrchr(listen, ':');
-	if (!colon || !colon[1])
-		return -1;
-	const char *h = listen;
-	size_t n = (size_t)(colon - listen);
-	if (n >= 2 && h[0] == '[' && h[n - 1] == ']') {
-		h++;
-		n -= 2;
+	struct http *h = cls;
+	if (code == MHD_CONNECTION_NOTIFY_STARTED) {
+		const union MHD_ConnectionInfo *info =
+			MHD_get_connection_info(connection, MHD_CONNECTION_INFO_CONNECTION_FD);
+		*socket_context = info ? front_door_connection_started(h->door, info->connect_fd) : NULL;
+	} else {
+		front_door_connection_closed(h->door, *socket_context);
+		*socket_context = NULL;
 	}
-	if (n == 0 || n >= host_size || strlen(colon + 1) >= port_size)
-		return -1;
-	memcpy(host, h, n);
-	host[n] = '\0';
-	snprintf(port, port_size, "%s", colon + 1);
-	return 0;
+}
+
+/* The front door's hand-over: libmicrohttpd closes the socket itself when it refuses it. */
+static int admit(void *cls, int fd, const struct sockaddr *addr, socklen_t addr_len)
+{
+	struct http *h = cls;
+	return MHD_add_connection(h->daemon, fd, addr, addr_len) == MHD_YES ? 0 : -1;
 }
 
 void *http_start(struct server *srv, char *url, size_t url_size, char *msg, size_t msg_size)
 {
-	char host[256], port[16];
-	if (split_listen(srv->cfg.listen, host, sizeof host, port, sizeof port) != 0) {
-		snprintf(msg, msg_size, "invalid --listen '%s': expected HOST:PORT", srv->cfg.listen);
+	struct http *h = calloc(1, sizeof *h);
+	if (!h) {
+		snprintf(msg, msg_size, "out of memory");
 		return NULL;
 	}
-	struct addrinfo hints = { .ai_family = AF_UNSPEC, .ai_socktype = SOCK_STREAM, .ai_flags = AI_PASSIVE };
-	struct addrinfo *ai = NULL;
-	int gai = getaddrinfo(host, port, &hints, &ai);
-	if (gai != 0) {
-		snprintf(msg, msg_size, "cannot resolve --listen '%s': %s", srv->cfg.listen, gai_strerror(gai));
+	h->srv = srv;
+	int connections = srv->cfg.max_connections + srv->cfg.max_worker_connections;
+	h->gate = request_gate_create(srv->cfg.max_requests_per_token, srv->cfg.max_requests_per_worker_token,
+				      srv->cfg.max_concurrent_submissions, connections);
+	if (!h->gate) {
+		snprintf(msg, msg_size, "out of memory");
+		http_stop(h);
 		return NULL;
 	}
+	/* no listening socket: connections come from the front door. The engine's own connection
+	 * limit sits above the front door's budgets, so it never refuses one the front door admitted. */
 	unsigned flags = MHD_USE_THREAD_PER_CONNECTION | MHD_USE_INTERNAL_POLLING_THREAD | MHD_USE_POLL |
-			 MHD_USE_ITC | MHD_USE_ERROR_LOG;
-	if (ai->ai_family == AF_INET6)
-		flags |= MHD_USE_IPv6;
-	struct MHD_Daemon *d = MHD_start_daemon(
-		flags, 0, NULL, NULL, on_request, srv, MHD_OPTION_SOCK_ADDR, ai->ai_addr,
-		MHD_OPTION_CONNECTION_LIMIT, (unsigned)srv->cfg.max_connections, MHD_OPTION_NOTIFY_COMPLETED,
-		on_completed, srv, MHD_OPTION_UNESCAPE_CALLBACK, no_unescape, NULL, MHD_OPTION_CONNECTION_TIMEOUT,
-		(unsigned)CONNECTION_TIMEOUT_SECONDS, MHD_OPTION_END);
-	freeaddrinfo(ai);
-	if (!d) {
-		snprintf(msg, msg_size, "cannot listen on '%s' (address in use or not available)", srv->cfg.listen);
+			 MHD_USE_ITC | MHD_USE_ERROR_LOG | MHD_USE_NO_LISTEN_SOCKET;
+	h->daemon = MHD_start_daemon(
+		flags, 0, NULL, NULL, on_request, h, MHD_OPTION_CONNECTION_LIMIT, (unsigned)(connections + 64),
+		MHD_OPTION_NOTIFY_COMPLETED, on_completed, h, MHD_OPTION_NOTIFY_CONNECTION, on_connection, h,
+		MHD_OPTION_UNESCAPE_CALLBACK, no_unescape, NULL, MHD_OPTION_CONNECTION_TIMEOUT,
+		(unsigned)CONNECTION_TIMEOUT_SECONDS, MHD_OPTION_CONNECTION_MEMORY_LIMIT, (size_t)CONNECTION_MEMORY,
+		MHD_OPTION_THREAD_STACK_SIZE, (size_t)THREAD_STACK_BYTES, MHD_OPTION_END);
+	if (!h->daemon) {
+		snprintf(msg, msg_size, "cannot start the HTTP engine");
+		http_stop(h);
 		return NULL;
 	}
-	const union MHD_DaemonInfo *info = MHD_get_daemon_info(d, MHD_DAEMON_INFO_LISTEN_FD);
-	struct sockaddr_storage bound;
-	socklen_t len = sizeof bound;
-	int actual = 0;
-	if (info && getsockname(info->listen_fd, (struct sockaddr *)&bound, &len) == 0)
-		actual = ntohs(bound.ss_family == AF_INET6 ? ((struct sockaddr_in6 *)&bound)->sin6_port
-							   : ((struct sockaddr_in *)&bound)->sin_port);
-	int v6 = strchr(host, ':') != NULL;
-	snprintf(url, url_size, "http://%s%s%s:%d", v6 ? "[" : "", host, v6 ? "]" : "", actual);
-	return d;
+	h->door = front_door_start(srv, admit, h, url, url_size, msg, msg_size);
+	if (!h->door) {
+		http_stop(h);
+		return NULL;
+	}
+	return h;
 }
 
-void http_quiesce(void *daemon)
+void http_quiesce(void *http)
 {
-	MHD_socket fd = MHD_quiesce_daemon(daemon);
-	if (fd != MHD_INVALID_SOCKET)
-		close(fd);
+	struct http *h = http;
+	front_door_quiesce(h->door);
 }
 
-void http_stop(void *daemon)
+void http_stop(void *http)
 {
-	if (daemon)
-		MHD_stop_daemon(daemon);
+	struct http *h = http;
+	if (!h)
+		return;
+	front_door_quiesce(h->door);
+	if (h->daemon)
+		MHD_stop_daemon(h->daemon);
+	front_door_destroy(&h->door);
+	request_gate_destroy(&h->gate);
+	free(h);
 }

@@ -1,7 +1,8 @@
 /*
  * http.h - requests and replies as the API handlers see them. http.c is the only file that
- * includes microhttpd.h: it parses, routes, authenticates, enforces body limits and turns a
- * struct reply into a libmicrohttpd response.
+ * includes microhttpd.h: it routes, authenticates, enforces body limits and per-token limits, and
+ * turns a struct reply into a libmicrohttpd response. Connections reach it through the front door
+ * (front_door.h), which checks each request head before libmicrohttpd parses it.
  *
  * A handler gets a struct request whose route, principal and path parameters are set and whose
  * body (for JSON routes) has been read completely within --max-body-bytes. It fills req->reply
@@ -78,14 +79,27 @@ void reply_stream(struct request *r, int status, const char *content_type, strea
 		  void (*free_cls)(void *cls));
 void reply_header(struct request *r, const char *name, const char *value);
 
+/* What a route's request body may be (docs/service.md §3 "Limits"): each kind has its own largest
+ * size and, for JSON, its own limits on nesting, values and token length, checked while the body
+ * streams in (common/json_scan.h) so that no tree is built of a body that breaks them. */
+enum body_kind {
+	BODY_SMALL,      /* small JSON objects (claims, heartbeats, finishes, users, tokens) or none */
+	BODY_LOG,        /* a log chunk: a few keys, one long string */
+	BODY_CASE,       /* a submission: a case spec of many values */
+	BODY_UPLOAD,     /* raw bytes streamed to the route's upload callbacks */
+};
+
 /* A route: method, path pattern ("/v1/jobs/{id}/files/{name}"; {name} as the last element takes
  * the rest of the path, slashes included, so hostile names reach the handler and are refused
- * there), the roles allowed, and either a handler or the upload callbacks. */
+ * there), the roles allowed, the body it takes, and either a handler or the upload callbacks.
+ * A submission route (body BODY_CASE) waits for its turn among the submissions being validated
+ * (request_gate.h). Every GET route answers HEAD too. */
 typedef void (*handler_fn)(struct request *r);
 struct route {
 	const char *method;
 	const char *pattern;
 	unsigned roles;                   /* ROLE_* mask; 0 = no token needed */
+	enum body_kind body;
 	handler_fn handle;
 	/* Streaming body (PUT): begin may reply to refuse before any byte is read; data gets each
 	 * piece (returns 0, or -1 after replying: the rest of the body is discarded); end replies;
@@ -96,12 +110,13 @@ struct route {
 	void (*upload_abort)(struct request *r);
 };
 
-/* Starts listening on cfg->listen (port 0 picks one) with one thread per connection. The actual
- * URL is written into url. Returns an opaque daemon, or NULL with msg set. */
+/* Starts the HTTP engine (one thread per connection) and the front door that listens on
+ * cfg->listen (port 0 picks one) and admits connections into it (front_door.h). The actual URL is
+ * written into url. Returns an opaque server, or NULL with msg set. */
 void *http_start(struct server *srv, char *url, size_t url_size, char *msg, size_t msg_size);
 /* Stops accepting new connections (in-flight requests go on). */
-void http_quiesce(void *daemon);
-/* Waits for every connection thread and stops. */
-void http_stop(void *daemon);
+void http_quiesce(void *http);
+/* Waits for every connection thread and stops; frees what http_start made. */
+void http_stop(void *http);
 
 #endif

@@ -18,13 +18,17 @@
 
 #include <errno.h>
 #include <fcntl.h>
+#include <malloc.h>
 #include <signal.h>
 #include <stddef.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/resource.h>
 #include <sys/stat.h>
 #include <unistd.h>
+
+#define MALLOC_ARENAS 2
 
 enum option_type { OPT_TEXT, OPT_INT, OPT_LONG };
 
@@ -44,7 +48,16 @@ struct option_def {
 static const struct option_def OPTIONS[] = {
 	TEXT_OPT("listen", listen, "HOST:PORT to listen on; port 0 picks a free one (default 127.0.0.1:8080)"),
 	TEXT_OPT("state", state, "state directory: poro.db, files/, server.url (default ./var)"),
-	INT_OPT("max-connections", max_connections, 1, 100000, "concurrent HTTP connections, one thread each (default 512)"),
+	INT_OPT("max-connections", max_connections, 1, 100000, "connections of users and clients without a token, one thread each (default 512)"),
+	INT_OPT("max-worker-connections", max_worker_connections, 1, 100000, "connections of worker tokens on /v1/worker/ routes, kept apart (default 256)"),
+	INT_OPT("max-connections-per-client", max_connections_per_client, 1, 100000, "user connections from one client address, waiting ones included (default 128)"),
+	INT_OPT("max-waiting-connections", max_waiting_connections, 16, 1000000, "connections whose first request head has not arrived yet (default 4096)"),
+	INT_OPT("header-timeout-seconds", header_timeout_seconds, 1, 3600, "a request head must arrive within this, and a connection may idle this long between requests (default 10)"),
+	INT_OPT("body-timeout-seconds", body_timeout_seconds, 1, 86400, "a JSON request body must arrive within this (default 60)"),
+	INT_OPT("max-requests-per-token", max_requests_per_token, 1, 100000, "requests in progress per user or admin token (default 32)"),
+	INT_OPT("max-requests-per-worker-token", max_requests_per_worker_token, 1, 100000, "requests in progress per worker token (default 512)"),
+	INT_OPT("max-concurrent-submissions", max_concurrent_submissions, 1, 1024, "submissions being validated at once (default 4)"),
+	LONG_OPT("max-body-values", max_body_values, 1000, 1LL << 40, "JSON values, keys included, in a submission's body (default 500000)"),
 	LONG_OPT("max-body-bytes", max_body_bytes, 1024, 1LL << 40, "largest JSON request body (default 4194304)"),
 	LONG_OPT("max-upload-bytes", max_upload_bytes, 1, 1LL << 50, "largest uploaded file (default 4294967296)"),
 	INT_OPT("lease-seconds", lease_seconds, 1, 86400, "lease length; each heartbeat renews it (default 30)"),
@@ -58,7 +71,10 @@ static const struct option_def OPTIONS[] = {
 #define OPTION_COUNT (sizeof OPTIONS / sizeof OPTIONS[0])
 
 static const struct server_config CONFIG_DEFAULTS = {
-	.listen = "127.0.0.1:8080", .state = "./var", .max_connections = 512, .max_body_bytes = 4LL << 20,
+	.listen = "127.0.0.1:8080", .state = "./var", .max_connections = 512, .max_worker_connections = 256,
+	.max_connections_per_client = 128, .max_waiting_connections = 4096, .header_timeout_seconds = 10,
+	.body_timeout_seconds = 60, .max_requests_per_token = 32, .max_requests_per_worker_token = 512,
+	.max_concurrent_submissions = 4, .max_body_values = 500000, .max_body_bytes = 4LL << 20,
 	.max_upload_bytes = 4LL << 30, .lease_seconds = 30, .max_attempts = 5, .user_max_queued = 10000,
 	.user_max_running = 0, .max_backoff_seconds = 60, .group_commit_max = 1024,
 };
@@ -256,8 +272,25 @@ static int write_url(const char *state, const char *url)
 	return ok && rename(tmp, path) == 0 ? 0 : -1;
 }
 
+/* Each connection costs a descriptor, and the front door holds many waiting ones: take the hard
+ * limit on descriptors as the soft one, as servers do (the default soft limit is often 1024). */
+static void raise_descriptor_limit(void)
+{
+	struct rlimit nofile;
+	if (getrlimit(RLIMIT_NOFILE, &nofile) == 0 && nofile.rlim_cur < nofile.rlim_max) {
+		nofile.rlim_cur = nofile.rlim_max;
+		setrlimit(RLIMIT_NOFILE, &nofile);
+	}
+}
+
 static int serve(struct server *srv)
 {
+	raise_descriptor_limit();
+	/* glibc gives threads arenas of their own, each reserving 64 MB of address space that it never
+	 * gives back; with hundreds of connection threads that is gigabytes reserved and memory kept
+	 * after a burst. The server's threads mostly wait on the network and the disk, so two arenas
+	 * cost no speed and keep what the server holds close to what it uses. */
+	mallopt(M_ARENA_MAX, MALLOC_ARENAS);
 	sigset_t signals;
 	sigemptyset(&signals);
 	sigaddset(&signals, SIGTERM);

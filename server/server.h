@@ -26,7 +26,16 @@
 struct server_config {
 	char listen[256];             /* HOST:PORT; port 0 picks a free one */
 	char state[SERVER_STATE_MAX];  /* state directory: poro.db, files/, server.url */
-	int max_connections;          /* concurrent HTTP connections (one thread each) */
+	int max_connections;          /* connections of users and clients without a token (one thread each) */
+	int max_worker_connections;   /* connections of worker tokens on /v1/worker/ routes, apart */
+	int max_connections_per_client; /* user connections from one client address, waiting ones included */
+	int max_waiting_connections;  /* connections whose first request head has not arrived yet */
+	int header_timeout_seconds;   /* a request head must arrive within this; also idle keep-alive */
+	int body_timeout_seconds;     /* a JSON request body must arrive within this */
+	int max_requests_per_token;   /* requests in progress per user or admin token */
+	int max_requests_per_worker_token; /* requests in progress per worker token */
+	int max_concurrent_submissions; /* submissions being validated at once */
+	long long max_body_values;    /* JSON values (keys included) in a submission's body */
 	long long max_body_bytes;     /* JSON request bodies, bytes */
 	long long max_upload_bytes;   /* one uploaded file, bytes */
 	int lease_seconds;            /* lease length; each heartbeat renews it */
@@ -42,6 +51,7 @@ struct server_config {
 #define API_ERROR_MAP(X)                                                     \
 	X(API_OK,                   200, "ok")                               \
 	X(API_INVALID_JSON,         400, "invalid_json")                     \
+	X(API_MALFORMED_REQUEST,    400, "malformed_request")                \
 	X(API_INVALID_PARAMETER,    400, "invalid_parameter")                \
 	X(API_INVALID_HEADER,       400, "invalid_header")                   \
 	X(API_INVALID_FILE_NAME,    400, "invalid_file_name")                \
@@ -50,19 +60,26 @@ struct server_config {
 	X(API_FORBIDDEN,            403, "forbidden")                        \
 	X(API_NOT_FOUND,            404, "not_found")                        \
 	X(API_METHOD_NOT_ALLOWED,   405, "method_not_allowed")               \
+	X(API_REQUEST_TIMEOUT,      408, "request_timeout")                  \
 	X(API_IDEMPOTENCY_CONFLICT, 409, "idempotency_conflict")             \
 	X(API_NOT_CANCELLABLE,      409, "not_cancellable")                  \
 	X(API_STALE_ATTEMPT,        409, "stale_attempt")                    \
 	X(API_LOG_GAP,              409, "log_gap")                          \
 	X(API_ALREADY_EXISTS,       409, "already_exists")                   \
 	X(API_TOO_LARGE,            413, "body_too_large")                   \
+	X(API_BODY_TOO_COMPLEX,     413, "body_too_complex")                 \
+	X(API_URI_TOO_LONG,         414, "uri_too_long")                     \
 	X(API_RANGE,                416, "range_not_satisfiable")            \
 	X(API_INVALID_REQUEST,      422, "invalid_request")                  \
 	X(API_INVALID_CASE,         422, "invalid_case")                     \
 	X(API_QUOTA_EXCEEDED,       429, "quota_exceeded")                   \
+	X(API_TOO_MANY_REQUESTS,    429, "too_many_requests")                \
+	X(API_TOO_MANY_CONNECTIONS, 429, "too_many_connections")             \
+	X(API_HEADERS_TOO_LARGE,    431, "header_fields_too_large")          \
 	X(API_INTERNAL,             500, "internal")                         \
 	X(API_NOT_IMPLEMENTED,      501, "not_implemented")                  \
-	X(API_UNAVAILABLE,          503, "unavailable")
+	X(API_UNAVAILABLE,          503, "unavailable")                      \
+	X(API_VERSION_NOT_SUPPORTED, 505, "http_version_not_supported")
 
 enum api_code {
 #define API_ERROR_ENUM(code, status, name) code,

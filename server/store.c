@@ -89,7 +89,9 @@ int conn_exec(struct conn *c, const char *sql)
 
 enum api_code db_fail(struct conn *c, struct api_error *err, const char *what)
 {
-	return api_fail(err, API_INTERNAL, "", "database error while %s: %s", what, sqlite3_errmsg(c->db));
+	/* out of memory is the server's passing state, not a fault: 503, retry later */
+	enum api_code code = sqlite3_errcode(c->db) == SQLITE_NOMEM ? API_UNAVAILABLE : API_INTERNAL;
+	return api_fail(err, code, "", "database error while %s: %s", what, sqlite3_errmsg(c->db));
 }
 
 const char *col_text(sqlite3_stmt *st, int i)

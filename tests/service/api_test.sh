@@ -150,7 +150,7 @@ expect_error bad_unknown_route_404 404 not_found "" "$code"
 code=$(svc_req DELETE "/v1/jobs/$id1" "$alice")
 allow=$(svc_header Allow)
 expect_error bad_wrong_method_405 405 method_not_allowed "" "$code"
-[ "$allow" = GET ]
+[ "$allow" = "GET, HEAD" ]
 check bad_wrong_method_allow_header $? "Allow '$allow'"
 code=$(svc_req GET /v1/jobs "")
 expect_error bad_missing_token_401 401 unauthorized Authorization "$code"

@@ -50,7 +50,8 @@ svc_start() {
 	# route coverage check (tests/service/route_coverage.sh)
 	local log_args=()
 	[ -n "${SVC_ROUTES_LOG:-}" ] && log_args=(--access-log "$SVC_ROUTES_LOG")
-	"$SVC_BUILD/poro-server" --listen 127.0.0.1:0 --state "$state" "${log_args[@]}" "$@" \
+	# SVC_WRAP (an array, e.g. (prlimit --as=200000000)) runs the server under another command
+	${SVC_WRAP[@]+"${SVC_WRAP[@]}"} "$SVC_BUILD/poro-server" --listen 127.0.0.1:0 --state "$state" "${log_args[@]}" "$@" \
 		> "$SVC_TMP/$name.out" 2> "$SVC_TMP/$name.err" &
 	SVC_PIDS[$name]=$!
 	SVC_STATES[$name]=$state
