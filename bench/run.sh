@@ -15,3 +15,5 @@ echo "== service: durable submissions, claims, log delay (bench/service.sh)"
 bash bench/service.sh "$build"
 echo "== materials: ns per stress update, elastic and plastic steps (bench/material_bench.c)"
 "$build"/bench/material_bench
+echo "== case validation: us per item at a tenth of each list's limit and at the limit (bench/case_validate_bench.c)"
+"$build"/bench/case_validate_bench

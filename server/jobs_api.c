@@ -3,12 +3,14 @@
  * probes (read from the job's latest result.h5 through the solver's results reader).
  *
  * A submission is checked completely before anything is stored: the request keys and ranges
- * (422 naming the key), then the case with the solver's own loader, case_load_string(), whose
- * "JSON-pointer: message" lines become problems [{"field": "/case<pointer>", "message"}] (422
- * invalid_case). The case is stored in canonical form (json_dumps with JSON_COMPACT |
- * JSON_SORT_KEYS), and case_sha256 is the SHA-256 of that text. The idempotency comparison uses
- * the SHA-256 of the whole request in the same canonical form, so key order and white space do
- * not make two identical requests differ.
+ * (422 naming the key; threads also against --max-job-threads), then the case with the solver's
+ * own loader, case_load_json(), on the tree already parsed from the body, so one tree is built,
+ * not two. Its "JSON-pointer: message" lines (at most CASE_PROBLEMS_MAX, then a count of the rest)
+ * become problems [{"field": "/case<pointer>", "message"}] (422 invalid_case, whose message gives
+ * the total). The case is stored in canonical form (json_dumps with JSON_COMPACT |
+ * JSON_SORT_KEYS: the loader's c->json), and case_sha256 is the SHA-256 of that text. The
+ * idempotency comparison uses the SHA-256 of the whole request in the same canonical form, so key
+ * order and white space do not make two identical requests differ.
  */
 #include "api.h"
 #include "store.h"
@@ -31,14 +33,17 @@
 #define LIST_LIMIT_DEFAULT 100
 #define ID_MAX 999999999999999999LL
 
-/* Turns the loader's "pointer: message" lines into problems under /case. */
+/* Turns the loader's "pointer: message" lines into problems under /case; the loader's last line
+ * "... and N more problems" is not a problem of its own (the total is case_problem_count's). */
 static json_t *case_problems(const char *message)
 {
 	json_t *problems = json_array();
 	const char *line = message;
-	while (line && *line) {
+	while (problems && line && *line) {
 		const char *end = strchr(line, '\n');
 		size_t n = end ? (size_t)(end - line) : strlen(line);
+		if (strncmp(line, CASE_PROBLEMS_MORE, strlen(CASE_PROBLEMS_MORE)) == 0)
+			break;
 		const char *sep = memchr(line, ':', n);
 		char field[SERVER_FIELD_MAX] = "/case";
 		const char *text = line;
@@ -61,37 +66,53 @@ static json_t *case_problems(const char *message)
 	return problems;
 }
 
-static int check_case(struct request *r, json_t *case_spec, char **canonical)
+/* Validates the case; 0 with the loaded case in *loaded (its json is the canonical text), or -1
+ * after replying 422 with the problems. */
+static int check_case(struct request *r, const json_t *case_spec, struct case_spec **loaded)
 {
-	*canonical = json_dumps(case_spec, JSON_COMPACT | JSON_SORT_KEYS);
-	if (!*canonical) {
-		reply_fail(r, API_INTERNAL, "", "cannot encode the case");
-		return -1;
-	}
-	struct case_spec *loaded = NULL;
 	struct poro_error *perr = calloc(1, sizeof *perr);
 	if (!perr) {
 		reply_fail(r, API_INTERNAL, "", "out of memory");
 		return -1;
 	}
-	enum poro_status st = case_load_string(*canonical, &loaded, perr);
-	case_destroy(&loaded);
+	enum poro_status st = case_load_json(case_spec, loaded, perr);
 	if (st == PORO_OK) {
 		free(perr);
 		return 0;
 	}
+	if (st != PORO_EINVAL) {      /* out of memory: the case may be fine, so try again later */
+		reply_fail(r, st == PORO_ENOMEM ? API_UNAVAILABLE : API_INTERNAL, "/case", "cannot check the case: %s",
+			   perr->message);
+		free(perr);
+		return -1;
+	}
 	struct api_error err = { 0 };
-	api_fail(&err, st == PORO_EINVAL ? API_INVALID_CASE : API_INTERNAL, "/case", "case is invalid");
+	api_fail(&err, API_INVALID_CASE, "/case", "case is invalid");
 	err.problems = case_problems(perr->message);
-	if (json_array_size(err.problems) > 0) {
+	size_t listed = json_array_size(err.problems);
+	long total = case_problem_count(perr->message);
+	if (listed > 0) {
 		json_t *first = json_array_get(err.problems, 0);
+		char shown[64] = "";
+		if ((long)listed < total)
+			snprintf(shown, sizeof shown, " (the first %zu listed)", listed);
 		snprintf(err.field, sizeof err.field, "%s", json_string_value(json_object_get(first, "field")));
-		snprintf(err.message, sizeof err.message, "case is invalid: %zu problem%s, first: %s",
-			 json_array_size(err.problems), json_array_size(err.problems) > 1 ? "s" : "",
-			 json_string_value(json_object_get(first, "message")));
+		snprintf(err.message, sizeof err.message, "case is invalid: %ld problem%s%s, first: %s", total,
+			 total > 1 ? "s" : "", shown, json_string_value(json_object_get(first, "message")));
 	}
 	free(perr);
 	reply_error(r, &err);
+	return -1;
+}
+
+/* A job may ask for at most this server's --max-job-threads: 0, or -1 after replying 422. */
+static int check_threads(struct request *r, long long threads)
+{
+	int limit = r->srv->cfg.max_job_threads;
+	if (threads <= limit)
+		return 0;
+	reply_fail(r, API_INVALID_REQUEST, "/threads",
+		   "'threads' must be at most %d, this server's limit (--max-job-threads), got %lld", limit, threads);
 	return -1;
 }
 
@@ -120,7 +141,8 @@ void jobs_submit(struct request *r)
 		return;
 	long long priority, threads, wall;
 	const char *name, *key;
-	char *canonical = NULL, *whole = NULL;
+	char *whole = NULL;
+	struct case_spec *loaded = NULL;
 	json_t *case_spec = json_object_get(body, "case");
 	if (api_known_keys(r, body, keys) || idempotency_key(r, &key))
 		goto done;
@@ -129,10 +151,11 @@ void jobs_submit(struct request *r)
 		goto done;
 	}
 	if (api_int_member(r, body, "priority", PRIORITY_MIN, PRIORITY_MAX, 0, &priority) ||
-	    api_int_member(r, body, "threads", 1, THREADS_MAX, 1, &threads) ||
+	    api_int_member(r, body, "threads", 1, THREADS_MAX, 1, &threads) || check_threads(r, threads) ||
 	    api_int_member(r, body, "wall_time_seconds", 1, WALL_TIME_MAX, WALL_TIME_DEFAULT, &wall) ||
-	    api_string_member(r, body, "name", SERVER_NAME_MAX, 0, &name) || check_case(r, case_spec, &canonical))
+	    api_string_member(r, body, "name", SERVER_NAME_MAX, 0, &name) || check_case(r, case_spec, &loaded))
 		goto done;
+	const char *canonical = loaded->json;
 	whole = json_dumps(body, JSON_COMPACT | JSON_SORT_KEYS);
 	char case_sha[DIGEST_HEX_SIZE], body_sha[DIGEST_HEX_SIZE];
 	digest_hex(canonical, strlen(canonical), case_sha);
@@ -153,7 +176,7 @@ void jobs_submit(struct request *r)
 	reply_header(r, "Location", location);
 	reply_json(r, created ? 201 : 200, job);
 done:
-	free(canonical);
+	case_destroy(&loaded);
 	free(whole);
 	json_decref(body);
 }

@@ -66,6 +66,7 @@ static const struct option_def OPTIONS[] = {
 	INT_OPT("user-max-running", user_max_running, 0, 100000000, "default per-user cap on running jobs, 0 = unlimited (default 0)"),
 	INT_OPT("max-backoff-seconds", max_backoff_seconds, 1, 86400, "cap of the retry backoff min(2^(attempt-1), cap) (default 60)"),
 	INT_OPT("group-commit-max", group_commit_max, 1, 100000, "most write requests in one transaction (default 1024)"),
+	INT_OPT("max-job-threads", max_job_threads, 1, 256, "most threads a job may ask for (default 64)"),
 	TEXT_OPT("access-log", access_log, "append 'METHOD ROUTE STATUS MILLISECONDS' per request to FILE (default none)"),
 };
 #define OPTION_COUNT (sizeof OPTIONS / sizeof OPTIONS[0])
@@ -77,6 +78,7 @@ static const struct server_config CONFIG_DEFAULTS = {
 	.max_concurrent_submissions = 4, .max_body_values = 500000, .max_body_bytes = 4LL << 20,
 	.max_upload_bytes = 4LL << 30, .lease_seconds = 30, .max_attempts = 5, .user_max_queued = 10000,
 	.user_max_running = 0, .max_backoff_seconds = 60, .group_commit_max = 1024,
+	.max_job_threads = 64,
 };
 
 static void usage(FILE *out)

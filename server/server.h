@@ -44,6 +44,7 @@ struct server_config {
 	int user_max_running;         /* default per-user cap on running jobs; 0 = unlimited */
 	int max_backoff_seconds;      /* cap of the retry backoff min(2^(attempt-1), cap) */
 	int group_commit_max;         /* most write requests in one transaction */
+	int max_job_threads;          /* most threads a job may ask for (1..256 on the wire) */
 	char access_log[SERVER_STATE_MAX]; /* one line per answered request, or "" for none */
 };
 

@@ -6,16 +6,45 @@
  * every problem is reported as one line "JSON-pointer: message" in the error record, and no
  * partially filled case is ever returned to the caller.
  *
- * Ownership: case_load_file()/case_load_string() return a heap object the caller frees with
- * case_destroy(&c). The original JSON text is kept in c->json (written to result files as /case).
+ * Validation costs time and memory linear in the size of the document: names are looked up in hash
+ * tables, not by scanning the lists, and every list and count a case implies (probes, grid cells,
+ * time steps, ...) has a limit below, far above any real case, so that a case which asks for an
+ * absurd amount of work is refused at once with the limit named (docs/case-spec.md, "Limits").
+ * The list of problems is bounded too (CASE_PROBLEMS_MAX).
+ *
+ * Ownership: case_load_file()/case_load_string()/case_load_json() return a heap object the caller
+ * frees with case_destroy(&c). The JSON text is kept in c->json (written to result files as /case).
  */
 #ifndef PORO_CASE_H
 #define PORO_CASE_H
 
 #include "error.h"
 
-#define CASE_NAME_MAX 64
 #define CASE_SCHEMA_VERSION "poro-case/1"
+
+/* Limits of a case (docs/case-spec.md, "Limits", and schemas/case.schema.json give the reasons).
+ * Each sits orders of magnitude above the largest case in tests/cases/ and near or beyond what a
+ * run could hold in memory, so it refuses only cases that could not run anyway. */
+#define CASE_NAME_MAX 64                 /* bytes of a name with its NUL: names are 1 to 63 characters */
+#define CASE_TITLE_MAX 255               /* bytes of the title */
+#define CASE_MATERIALS_MAX 1000
+#define CASE_BODIES_MAX 1000
+#define CASE_LOADS_MAX 1000
+#define CASE_PROBES_MAX 10000
+#define CASE_POLYGON_MAX 64              /* vertices of one polygon */
+#define CASE_POLYGON_VERTICES_MAX 10000  /* vertices of all the polygons of a case */
+#define CASE_CELLS_MAX 100000000.0       /* grid cells; the grid holds about 300 bytes a node */
+#define CASE_POINTS_MAX 100000000.0      /* material points, estimated from the bodies' areas */
+#define CASE_STEPS_MAX 1000000000.0      /* time steps, end / dt */
+#define CASE_FRAMES_MAX 100000.0         /* output frames, end / frame_interval (one a step at most) */
+#define CASE_CHECKPOINTS_MAX 10000.0     /* checkpoints, end / checkpoint interval (one a step at most) */
+
+/* A refused case's message lists at most CASE_PROBLEMS_MAX problems, one "JSON-pointer: message"
+ * line each, in the order of the document (fewer when they would not fit in the message); when
+ * there were more, a last line CASE_PROBLEMS_MORE followed by how many ("... and 900 more
+ * problems"). case_problem_count() reads the total back from such a message. */
+#define CASE_PROBLEMS_MAX 100
+#define CASE_PROBLEMS_MORE "... and "
 
 enum case_scheme { SCHEME_SEMI_IMPLICIT };
 enum case_phases { PHASES_DOUBLE_POINT, PHASES_SINGLE_POINT };
@@ -145,7 +174,6 @@ struct case_material {
 	double gas_volume_ratio;          /* v_crit / v0 > 1, default 1.6 (000 Eqs. 93-94) */
 };
 
-#define CASE_POLYGON_MAX 64
 struct case_body {
 	char name[CASE_NAME_MAX];
 	int material;                     /* index into case.materials */
@@ -196,7 +224,7 @@ struct case_probe {
 };
 
 struct case_spec {
-	char title[256];
+	char title[CASE_TITLE_MAX + 1];
 	struct case_formulation formulation;
 	struct case_grid grid;
 	int material_count;
@@ -242,11 +270,22 @@ struct case_spec {
 	char *json;                       /* the case as given, NUL-terminated */
 };
 
-/* Loads and validates a case. On failure returns PORO_EINVAL (or PORO_EIO for an unreadable file)
- * with every problem listed in err->message, one "JSON-pointer: message" per line, and *out NULL. */
+typedef struct json_t json_t;
+
+/* Loads and validates a case. On failure returns PORO_EINVAL (or PORO_EIO for an unreadable file,
+ * PORO_ENOMEM) with the problems listed in err->message as described at CASE_PROBLEMS_MAX, and
+ * *out NULL. case_load_string() keeps json as c->json. */
 enum poro_status case_load_file(const char *path, struct case_spec **out, struct poro_error *err);
 enum poro_status case_load_string(const char *json, struct case_spec **out, struct poro_error *err);
+/* The same on a document jansson has already parsed (the server's request body), so that one tree
+ * is built, not two. root is only read and not kept. c->json is root in canonical form: compact,
+ * keys sorted (json_dumps with JSON_COMPACT | JSON_SORT_KEYS), the text the server stores. */
+enum poro_status case_load_json(const json_t *root, struct case_spec **out, struct poro_error *err);
 void case_destroy(struct case_spec **c);
+
+/* How many problems a refused case's message stands for: its lines, with a last line
+ * CASE_PROBLEMS_MORE "N more problems" counted as N. 0 for NULL or "". */
+long case_problem_count(const char *message);
 
 /* Compares two case texts as JSON values: key order, white space and the spelling of numbers
  * (2, 2.0, 2e0) do not matter. Returns 0 when equal; 1 when they differ, with the JSON pointer

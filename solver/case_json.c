@@ -10,6 +10,11 @@
  * Strings from the document that appear in messages are cut short and control characters are
  * replaced by '?' (case_quote), so that every problem stays one line.
  *
+ * Problems are capped (CASE_PROBLEMS_MAX in case.h): the first ones are written into the error
+ * record as they come, the rest only counted, with one last line that says how many more there
+ * were. Names of list items are kept in jansson objects (struct case_names), so that checking a
+ * list of n names costs n hash lookups, not n^2/2 comparisons.
+ *
  * It also compares two case texts as JSON values (case_json_difference in case.h), which is how a
  * checkpoint is matched to the case a resumed run is given.
  */
@@ -25,9 +30,28 @@
 #include "case.h"
 
 #define PROBLEM_MAX 1024            /* longest single problem message */
+/* Room kept at the end of the message for the line "... and N more problems". */
+#define MORE_LINE_SIZE (sizeof "\n" CASE_PROBLEMS_MORE "2147483647 more problems")
+
+/* Rewrites the last line of the message, "... and N more problems", after a problem past the cap:
+ * a short snprintf at a known offset, so counting costs the same for the millionth problem. */
+static void write_more_line(struct case_reader *r)
+{
+	int more = r->problem_count - r->recorded;
+	snprintf(r->err->message + r->used, sizeof r->err->message - r->used, "\n%s%d more problem%s",
+		 CASE_PROBLEMS_MORE, more, more == 1 ? "" : "s");
+}
 
 void case_problem(struct case_reader *r, const char *pointer, const char *fmt, ...)
 {
+	/* Only a prefix of the problems is recorded, so the list reads in document order. */
+	int listing = r->recorded == r->problem_count++ && r->recorded < CASE_PROBLEMS_MAX;
+	if (!r->err)
+		return;
+	if (!listing) {
+		write_more_line(r);
+		return;
+	}
 	char message[PROBLEM_MAX];
 	va_list ap;
 	va_start(ap, fmt);
@@ -35,10 +59,34 @@ void case_problem(struct case_reader *r, const char *pointer, const char *fmt, .
 	va_end(ap);
 	/* The empty pointer is the whole document; show it as "/" so every line starts alike. */
 	const char *where = pointer[0] ? pointer : "/";
-	if (r->problem_count++ == 0)
+	if (r->recorded == 0) {
 		poro_error_set(r->err, PORO_EINVAL, "%s: %s", where, message);
-	else
-		poro_error_append(r->err, "%s: %s", where, message);
+		r->used = strlen(r->err->message);
+		r->recorded = 1;
+		return;
+	}
+	size_t room = sizeof r->err->message - r->used;
+	int n = snprintf(r->err->message + r->used, room, "\n%s: %s", where, message);
+	if (n > 0 && (size_t)n + MORE_LINE_SIZE < room) {
+		r->used += (size_t)n;
+		r->recorded++;
+	} else {
+		write_more_line(r);                 /* overwrites the line that did not fit */
+	}
+}
+
+long case_problem_count(const char *message)
+{
+	long lines = 0;
+	for (const char *line = message; line && *line;) {
+		const char *end = strchr(line, '\n');
+		if (strncmp(line, CASE_PROBLEMS_MORE, strlen(CASE_PROBLEMS_MORE)) == 0)
+			lines += strtol(line + strlen(CASE_PROBLEMS_MORE), NULL, 10);
+		else
+			lines++;
+		line = end ? end + 1 : NULL;
+	}
+	return lines;
 }
 
 const char *case_quote(char *dst, const char *s)
@@ -110,8 +158,7 @@ json_t *case_json_parse(struct case_reader *r, const char *text)
 		case_problem(r, "", "malformed JSON at line %d column %d: %s", e.line, e.column, e.text);
 		return NULL;
 	}
-	if (!json_is_object(doc)) {
-		case_problem(r, "", "expected an object, got %s", type_name(doc));
+	if (!case_json_root(r, doc)) {
 		json_decref(doc);
 		return NULL;
 	}
@@ -121,6 +168,67 @@ json_t *case_json_parse(struct case_reader *r, const char *text)
 void case_json_free(json_t *doc)
 {
 	json_decref(doc);
+}
+
+int case_json_root(struct case_reader *r, const json_t *doc)
+{
+	if (json_is_object(doc))
+		return 1;
+	case_problem(r, "", "expected an object, got %s", doc ? type_name(doc) : "nothing");
+	return 0;
+}
+
+char *case_json_text(const json_t *doc)
+{
+	return json_dumps(doc, JSON_COMPACT | JSON_SORT_KEYS);
+}
+
+void case_names_init(struct case_reader *r, struct case_names *n)
+{
+	if (!(n->index = json_object()))
+		r->out_of_memory = 1;
+}
+
+int case_names_add(struct case_reader *r, struct case_names *n, const char *name, int index)
+{
+	int earlier = case_names_find(n, name);
+	/* names are checked ASCII before they get here: no UTF-8 check needed */
+	if (earlier < 0 && n->index && json_object_set_new_nocheck(n->index, name, json_integer(index)))
+		r->out_of_memory = 1;
+	return earlier;
+}
+
+int case_names_find(const struct case_names *n, const char *name)
+{
+	const json_t *v = n->index ? json_object_get(n->index, name) : NULL;
+	return v ? (int)json_integer_value(v) : -1;
+}
+
+void case_names_release(struct case_names *n)
+{
+	json_decref(n->index);
+	n->index = NULL;
+}
+
+/* A count for a message: whole up to 1e15, beyond that in the shortest exact form. */
+static const char *format_count(char *dst, double x)
+{
+	if (x < 1e15)
+		snprintf(dst, CASE_NUMBER_SIZE, "%.0f", x);
+	else
+		case_format_number(dst, x);
+	return dst;
+}
+
+int case_check_limit(struct case_reader *r, const char *pointer, const char *verb, const char *what,
+		     double got, double limit)
+{
+	char a[CASE_NUMBER_SIZE], b[CASE_NUMBER_SIZE];
+	if (got <= limit)
+		return 1;
+	case_problem(r, pointer, "must %s at most %s %s (the case limit), got %s", verb, format_count(a, limit), what,
+		     format_count(b, got));
+	return 0;
 }
 
 static int is_allowed(const char *key, const char *const *allowed)
@@ -392,6 +500,19 @@ const json_t *case_read_array(struct case_reader *r, const json_t *obj, const ch
 		return NULL;
 	}
 	*count = json_array_size(v);
+	return v;
+}
+
+const json_t *case_read_list(struct case_reader *r, const json_t *obj, const char *base, const char *key,
+			     enum case_need need, size_t max, const char *what, size_t *count)
+{
+	char pointer[CASE_POINTER_MAX];
+	const json_t *v = case_read_array(r, obj, base, key, need, count);
+	case_pointer_key(pointer, base, key);
+	if (v && !case_check_limit(r, pointer, "list", what, (double)*count, (double)max)) {
+		*count = 0;
+		return NULL;
+	}
 	return v;
 }
 

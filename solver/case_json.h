@@ -3,9 +3,11 @@
  *
  * case_load.c reads a case section by section through these functions and never calls jansson
  * itself; case_json.c is the one file jansson enters through (STYLE rule 5). Every read knows the
- * JSON pointer (RFC 6901) of what it reads, and every problem it finds is recorded in the reader as
- * one line "JSON-pointer: message" and counted; reading then goes on, so one pass lists every
- * problem of a document.
+ * JSON pointer (RFC 6901) of what it reads, and every problem it finds is counted in the reader and,
+ * among the first CASE_PROBLEMS_MAX (case.h), recorded as one line "JSON-pointer: message";
+ * reading then goes on, so one pass lists the problems of a document and says how many there were.
+ * A problem past the cap costs a counter and a short line, so a document of a million bad items
+ * costs no more to refuse than to read.
  *
  * Conventions of the read functions: `base` is the pointer of the object read from ("" for the
  * root), `key` the member. A member read returns 1 when the member is present and valid (the value
@@ -26,8 +28,10 @@ typedef struct json_t json_t;
 
 struct case_reader {
 	struct poro_error *err;     /* where problems go; may be NULL */
-	int problem_count;          /* problems recorded so far */
+	int problem_count;          /* problems found so far */
 	int out_of_memory;          /* an allocation failed while reading */
+	int recorded;               /* problems written into err->message, a prefix of those found */
+	size_t used;                /* bytes of err->message those lines fill (without the "more" line) */
 };
 
 enum case_need { CASE_OPTIONAL, CASE_REQUIRED };
@@ -41,7 +45,7 @@ struct case_range {
 	double hi;
 };
 
-/* Records one problem, "pointer: message". */
+/* Counts one problem and records it as "pointer: message" while under the cap (case.h). */
 void case_problem(struct case_reader *r, const char *pointer, const char *fmt, ...)
 	__attribute__((format(printf, 3, 4)));
 
@@ -66,6 +70,28 @@ enum poro_status case_read_text(const char *path, char **text, struct poro_error
  * NULL. The root must be an object. Frees with case_json_free(). */
 json_t *case_json_parse(struct case_reader *r, const char *text);
 void case_json_free(json_t *doc);
+/* 1 when doc, parsed by the caller, is an object; otherwise records "/: expected an object, got T". */
+int case_json_root(struct case_reader *r, const json_t *doc);
+/* doc in canonical form (compact, keys sorted), a heap string the caller frees; NULL without memory. */
+char *case_json_text(const json_t *doc);
+
+/* The names of a list's items (materials, bodies, probes), for duplicate checks and references
+ * in constant time per name: a jansson object from name to item index, i.e. jansson's hash table,
+ * whose hash is seeded at random per process so that chosen names cannot force collisions.
+ * case_names_add returns -1 when the name is new (and keeps index for it), else the index kept
+ * for the name, whose first item stays the one found. Both record out of memory in r. */
+struct case_names {
+	json_t *index;
+};
+void case_names_init(struct case_reader *r, struct case_names *n);
+int case_names_add(struct case_reader *r, struct case_names *n, const char *name, int index);
+int case_names_find(const struct case_names *n, const char *name);   /* -1 when absent */
+void case_names_release(struct case_names *n);
+
+/* Records "pointer: must VERB at most LIMIT WHAT (the case limit), got GOT" unless got <= limit;
+ * returns 1 when within it. For the counts a case implies (cells, steps, ...). */
+int case_check_limit(struct case_reader *r, const char *pointer, const char *verb, const char *what,
+		     double got, double limit);
 
 /* Records "pointer/key: unknown key" for every member of obj not in allowed (NULL-terminated). */
 void case_check_keys(struct case_reader *r, const json_t *obj, const char *base,
@@ -98,6 +124,10 @@ const json_t *case_read_object(struct case_reader *r, const json_t *obj, const c
 			       const char *key, enum case_need need);
 const json_t *case_read_array(struct case_reader *r, const json_t *obj, const char *base,
 			      const char *key, enum case_need need, size_t *count);
+/* An array of at most max items, called what in the message: NULL, *count 0 and the problem of
+ * case_check_limit when longer, so that no item of an oversized list is read. */
+const json_t *case_read_list(struct case_reader *r, const json_t *obj, const char *base, const char *key,
+			     enum case_need need, size_t max, const char *what, size_t *count);
 
 /* Value reads, for array items: v at pointer must be an object / two numbers. */
 int case_expect_object(struct case_reader *r, const json_t *v, const char *pointer);

@@ -13,8 +13,14 @@
  * material, a load's body) are resolved against the items read before them, which is why
  * materials come before bodies and bodies before loads.
  *
- * Geometric tolerances are relative to the grid extent (GRID_TOLERANCE), so a body that ends
- * exactly on the grid edge, written with decimal rounding, still lies inside.
+ * Geometric tolerances are relative to the grid extent (CASE_GRID_TOLERANCE), so a body that ends
+ * exactly on the grid edge, written with decimal rounding, still lies inside. The regions
+ * themselves (boxes, polygons) are read in case_region.c.
+ *
+ * The cost of a check is linear in the document: names go into hash tables as they are read
+ * (struct case_names), a list longer than its limit (case.h) is refused whole without reading its
+ * items, and the work a case implies (grid cells, material points, time steps, frames,
+ * checkpoints) is checked against its limit as soon as the values it follows from are known.
  */
 #include "case.h"
 
@@ -27,6 +33,7 @@
 
 #include "case_json.h"
 #include "case_material.h"
+#include "case_region.h"
 
 /* Defaults of optional values (documented in schemas/case.schema.json and docs/case-spec.md). */
 #define DEFAULT_FLUID_DENSITY 1000.0      /* kg/m^3, water */
@@ -41,13 +48,8 @@
 
 /* Limits. */
 #define GRID_CELLS_MIN 3                  /* cells per direction: room for a quadratic B-spline */
-#define GRID_TOLERANCE 1e-9               /* relative: extent/cell_size integrality, inside-grid tests */
-#define POLYGON_VERTICES_MIN 3
-#define POLYGON_AREA_TOLERANCE 1e-12      /* |area| / bounding-box area below this counts as zero */
 #define PARTICLES_PER_CELL_MIN 1
 #define PARTICLES_PER_CELL_MAX 8
-#define REGION_SIZE (4 * CASE_NUMBER_SIZE + 16) /* "[x0, y0] to [x1, y1]" */
-#define TITLE_MAX (sizeof ((struct case_spec *)0)->title - 1) /* bytes */
 
 static const struct case_range POSITIVE = { BOUND_OPEN, 0, BOUND_NONE, 0 };
 static const struct case_range NON_NEGATIVE = { BOUND_CLOSED, 0, BOUND_NONE, 0 };
@@ -94,7 +96,6 @@ static const char *const grid_keys[] = { "origin", "extent", "cell_size", NULL }
 static const char *const material_keys[] = { "name", "density", NULL };
 static const char *const body_keys[] = { "name", "material", "rectangle", "polygon", "particles_per_cell",
 					 "porosity", "hydraulic_conductivity", "permeability_law", NULL };
-static const char *const box_keys[] = { "min", "max", NULL };
 static const char *const fluid_keys[] = { "density", "bulk_modulus", "cavitation_pressure",
 					  "cavitated_bulk_modulus", NULL };
 static const char *const gravity_keys[] = { "acceleration", "ramp_time", "elastic_loading", "loading_conductivity",
@@ -139,96 +140,18 @@ static void *alloc_items(struct case_reader *r, size_t n, size_t size)
 	return items;
 }
 
-static int find_material(const struct case_spec *c, int count, const char *name)
-{
-	for (int i = 0; i < count; i++)
-		if (c->materials[i].name[0] && strcmp(c->materials[i].name, name) == 0)
-			return i;
-	return -1;
-}
-
-static int find_body(const struct case_spec *c, int count, const char *name)
-{
-	for (int i = 0; i < count; i++)
-		if (c->bodies[i].name[0] && strcmp(c->bodies[i].name, name) == 0)
-			return i;
-	return -1;
-}
-
-static int find_probe(const struct case_spec *c, int count, const char *name)
-{
-	for (int i = 0; i < count; i++)
-		if (c->probes[i].name[0] && strcmp(c->probes[i].name, name) == 0)
-			return i;
-	return -1;
-}
-
-/* Records "LIST/i/name: duplicate KIND name 'NAME', also at LIST/earlier" if earlier >= 0. */
-static void check_unique(struct case_reader *r, const char *list, int i, const char *kind, const char *name,
-			 int earlier)
+/* Adds item i's name (when it was read) to names, and records "LIST/i/name: duplicate KIND name
+ * 'NAME', also at LIST/earlier" when an earlier item has it. */
+static void check_unique(struct case_reader *r, struct case_names *names, const char *list, int i,
+			 const char *kind, const char *name)
 {
 	char item[CASE_POINTER_MAX], pointer[CASE_POINTER_MAX];
+	int earlier = name[0] ? case_names_add(r, names, name, i) : -1;
 	if (earlier < 0)
 		return;
 	case_pointer_index(item, list, (size_t)i);
 	case_pointer_key(pointer, item, "name");
 	case_problem(r, pointer, "duplicate %s name '%s', also at %s/%d", kind, name, list, earlier);
-}
-
-/* 1 when the box [min, max] lies within the grid, up to GRID_TOLERANCE of its extent. */
-static int inside_grid(const struct case_grid *g, const double min[2], const double max[2])
-{
-	for (int d = 0; d < 2; d++) {
-		double slack = GRID_TOLERANCE * g->extent[d];
-		if (min[d] < g->origin[d] - slack || max[d] > g->origin[d] + g->extent[d] + slack)
-			return 0;
-	}
-	return 1;
-}
-
-/* Writes "[x, y]" for a point (min == max), else "[x0, y0] to [x1, y1]", into dst[REGION_SIZE]. */
-static const char *format_region(char *dst, const double min[2], const double max[2])
-{
-	char a[CASE_NUMBER_SIZE], b[CASE_NUMBER_SIZE], c[CASE_NUMBER_SIZE], d[CASE_NUMBER_SIZE];
-	int n = snprintf(dst, REGION_SIZE, "[%s, %s]", case_format_number(a, min[0]),
-			 case_format_number(b, min[1]));
-	if (min[0] != max[0] || min[1] != max[1])
-		snprintf(dst + n, REGION_SIZE - (size_t)n, " to [%s, %s]", case_format_number(c, max[0]),
-			 case_format_number(d, max[1]));
-	return dst;
-}
-
-/* Records "pointer: WHAT lies outside the grid: ..." unless [min, max] is inside it. */
-static void check_inside_grid(struct case_reader *r, const char *pointer, const char *what,
-			      const struct case_grid *g, const double min[2], const double max[2])
-{
-	if (inside_grid(g, min, max))
-		return;
-	char region[REGION_SIZE], grid[REGION_SIZE];
-	double top[2] = { g->origin[0] + g->extent[0], g->origin[1] + g->extent[1] };
-	case_problem(r, pointer, "%s lies outside the grid: %s, grid %s", what,
-		     format_region(region, min, max), format_region(grid, g->origin, top));
-}
-
-/* Reads {"min": [x, y], "max": [x, y]} with min < max in both directions. */
-static int read_box(struct case_reader *r, const json_t *obj, const char *base, const char *key,
-		    double min[2], double max[2])
-{
-	char pointer[CASE_POINTER_MAX];
-	const json_t *box = case_read_object(r, obj, base, key, CASE_REQUIRED);
-	if (!box)
-		return 0;
-	case_pointer_key(pointer, base, key);
-	case_check_keys(r, box, pointer, box_keys);
-	int ok = case_read_vec2(r, box, pointer, "min", CASE_REQUIRED, NULL, min);
-	ok &= case_read_vec2(r, box, pointer, "max", CASE_REQUIRED, NULL, max);
-	if (ok && !(min[0] < max[0] && min[1] < max[1])) {
-		char max_pointer[CASE_POINTER_MAX];
-		case_pointer_key(max_pointer, pointer, "max");
-		case_problem(r, max_pointer, "must be greater than min in both x and y");
-		return 0;
-	}
-	return ok;
 }
 
 static void read_header(struct case_reader *r, const json_t *root, struct case_spec *c)
@@ -239,8 +162,8 @@ static void read_header(struct case_reader *r, const json_t *root, struct case_s
 	if (!case_read_string(r, root, "", "title", CASE_OPTIONAL, &title))
 		return;
 	size_t length = strlen(title);
-	if (length > TITLE_MAX)
-		case_problem(r, "/title", "must be at most %zu bytes long, got %zu", TITLE_MAX, length);
+	if (length > CASE_TITLE_MAX)
+		case_problem(r, "/title", "must be at most %d bytes long, got %zu", CASE_TITLE_MAX, length);
 	else
 		memcpy(c->title, title, length + 1);
 }
@@ -295,7 +218,7 @@ static int check_cell_count(struct case_reader *r, const struct case_grid *g, in
 	char pointer[CASE_POINTER_MAX], h[CASE_NUMBER_SIZE], got[CASE_NUMBER_SIZE];
 	case_pointer_index(pointer, "/grid/extent", (size_t)d);
 	double cells = round(g->extent[d] / g->cell_size);
-	if (fabs(g->extent[d] - cells * g->cell_size) > GRID_TOLERANCE * g->extent[d] || cells < 1) {
+	if (fabs(g->extent[d] - cells * g->cell_size) > CASE_GRID_TOLERANCE * g->extent[d] || cells < 1) {
 		case_problem(r, pointer, "must be a positive multiple of /grid/cell_size (%s), got %s",
 			     case_format_number(h, g->cell_size), case_format_number(got, g->extent[d]));
 		return 0;
@@ -323,6 +246,10 @@ static int read_grid(struct case_reader *r, const json_t *root, struct case_grid
 		extent_ok &= check_cell_count(r, g, 0);
 		extent_ok &= check_cell_count(r, g, 1);
 	}
+	/* checked before anything is sized from the grid; each direction is then below 2^31 too */
+	if (extent_ok && cell_size_ok)
+		extent_ok = case_check_limit(r, p, "have", "cells", round(g->extent[0] / g->cell_size) *
+					     round(g->extent[1] / g->cell_size), CASE_CELLS_MAX);
 	return ok && extent_ok && cell_size_ok;
 }
 
@@ -333,14 +260,16 @@ static void read_material(struct case_reader *r, const json_t *o, const char *p,
 	case_read_number(r, o, p, "density", CASE_REQUIRED, &POSITIVE, &m->density);
 }
 
-static void read_materials(struct case_reader *r, const json_t *root, struct case_spec *c)
+/* Returns 1 when the list was there to be read, so names can be looked up in it. */
+static int read_materials(struct case_reader *r, const json_t *root, struct case_spec *c,
+			  struct case_names *names)
 {
 	size_t n;
-	const json_t *a = case_read_array(r, root, "", "materials", CASE_REQUIRED, &n);
+	const json_t *a = case_read_list(r, root, "", "materials", CASE_REQUIRED, CASE_MATERIALS_MAX, "materials", &n);
 	if (a && n == 0)
 		case_problem(r, "/materials", "must list at least one material");
 	if (!a || !(c->materials = alloc_items(r, n, sizeof *c->materials)))
-		return;
+		return a != NULL;
 	c->material_count = (int)n;
 	for (int i = 0; i < c->material_count; i++) {
 		char p[CASE_POINTER_MAX];
@@ -349,116 +278,60 @@ static void read_materials(struct case_reader *r, const json_t *root, struct cas
 		if (!case_expect_object(r, case_array_item(a, (size_t)i), p))
 			continue;
 		read_material(r, case_array_item(a, (size_t)i), p, m);
-		check_unique(r, "/materials", i, "material", m->name, find_material(c, i, m->name));
+		check_unique(r, names, "/materials", i, "material", m->name);
 	}
+	return 1;
 }
 
-/* Resolves the material name of a body to an index; -1 when unknown. */
-static int read_material_ref(struct case_reader *r, const json_t *o, const char *p, const struct case_spec *c)
+/* Resolves the material name of a body to an index; -1 when unknown, or when the list could not
+ * be read (materials NULL: its problem is already recorded, and one line per body would repeat it). */
+static int read_material_ref(struct case_reader *r, const json_t *o, const char *p,
+			     const struct case_names *materials)
 {
 	char pointer[CASE_POINTER_MAX], shown[CASE_QUOTE_SIZE];
 	const char *name;
 	if (!case_read_string(r, o, p, "material", CASE_REQUIRED, &name))
 		return -1;
-	int index = find_material(c, c->material_count, name);
-	if (index < 0) {
+	int index = materials ? case_names_find(materials, name) : -1;
+	if (index < 0 && materials) {
 		case_pointer_key(pointer, p, "material");
 		case_problem(r, pointer, "unknown material '%s'", case_quote(shown, name));
 	}
 	return index;
 }
 
-/* Twice the signed area of a polygon (shoelace formula). */
-static double polygon_area2(const double (*v)[2], int n)
-{
-	double sum = 0;
-	for (int i = 0, j = n - 1; i < n; j = i++)
-		sum += v[j][0] * v[i][1] - v[i][0] * v[j][1];
-	return sum;
-}
-
-static void bounding_box(struct case_body *b)
-{
-	for (int d = 0; d < 2; d++) {
-		b->min[d] = b->max[d] = b->polygon[0][d];
-		for (int i = 1; i < b->polygon_count; i++) {
-			b->min[d] = fmin(b->min[d], b->polygon[i][d]);
-			b->max[d] = fmax(b->max[d], b->polygon[i][d]);
-		}
-	}
-}
-
-static int read_polygon(struct case_reader *r, const json_t *o, const char *p, struct case_body *b)
-{
-	char pointer[CASE_POINTER_MAX], vertex[CASE_POINTER_MAX];
-	size_t n;
-	const json_t *a = case_read_array(r, o, p, "polygon", CASE_REQUIRED, &n);
-	if (!a)
-		return 0;
-	case_pointer_key(pointer, p, "polygon");
-	if (n < POLYGON_VERTICES_MIN || n > CASE_POLYGON_MAX) {
-		case_problem(r, pointer, "must have %d to %d vertices, got %zu", POLYGON_VERTICES_MIN,
-			     CASE_POLYGON_MAX, n);
-		return 0;
-	}
-	int ok = 1;
-	for (size_t i = 0; i < n; i++) {
-		case_pointer_index(vertex, pointer, i);
-		ok &= case_value_vec2(r, case_array_item(a, i), vertex, NULL, b->polygon[i]);
-	}
-	if (!ok)
-		return 0;
-	b->is_polygon = 1;
-	b->polygon_count = (int)n;
-	bounding_box(b);
-	double box_area = (b->max[0] - b->min[0]) * (b->max[1] - b->min[1]);
-	if (!(fabs(0.5 * polygon_area2(b->polygon, b->polygon_count)) > POLYGON_AREA_TOLERANCE * box_area)) {
-		case_problem(r, pointer, "must enclose a non-zero area");
-		return 0;
-	}
-	return 1;
-}
-
-/* Reads the body's region: exactly one of "rectangle" and "polygon". */
-static int read_region(struct case_reader *r, const json_t *o, const char *p, struct case_body *b)
-{
-	int rectangle = case_has_key(o, "rectangle"), polygon = case_has_key(o, "polygon");
-	if (rectangle == polygon) {
-		case_problem(r, p, "must have exactly one of 'rectangle' and 'polygon', got %s",
-			     rectangle ? "both" : "neither");
-		return 0;
-	}
-	if (polygon)
-		return read_polygon(r, o, p, b);
-	return read_box(r, o, p, "rectangle", b->min, b->max);
-}
-
-static void read_body(struct case_reader *r, const json_t *o, const char *p, const struct case_spec *c,
-		      int grid_ok, struct case_body *b)
+/* Returns 1 when the body's region and particles_per_cell were read, so its points can be counted. */
+static int read_body(struct case_reader *r, const json_t *o, const char *p, const struct case_spec *c,
+		     int grid_ok, const struct case_names *materials, struct case_body *b)
 {
 	case_check_keys(r, o, p, body_keys);
 	case_read_name(r, o, p, "name", CASE_REQUIRED, b->name, sizeof b->name);
-	b->material = read_material_ref(r, o, p, c);
-	if (read_region(r, o, p, b) && grid_ok)
-		check_inside_grid(r, p, "body", &c->grid, b->min, b->max);
-	case_read_int(r, o, p, "particles_per_cell", CASE_REQUIRED, PARTICLES_PER_CELL_MIN,
-		      PARTICLES_PER_CELL_MAX, &b->particles_per_cell);
+	b->material = read_material_ref(r, o, p, materials);
+	int seeded = case_read_region(r, o, p, b);
+	if (seeded && grid_ok)
+		case_check_inside_grid(r, p, "body", &c->grid, b->min, b->max);
+	seeded &= case_read_int(r, o, p, "particles_per_cell", CASE_REQUIRED, PARTICLES_PER_CELL_MIN,
+				PARTICLES_PER_CELL_MAX, &b->particles_per_cell);
 	case_read_number(r, o, p, "porosity", CASE_REQUIRED, &POROSITY, &b->porosity);
 	case_read_number(r, o, p, "hydraulic_conductivity", CASE_REQUIRED, &POSITIVE,
 			 &b->hydraulic_conductivity);
 	b->permeability_law = read_choice_or(r, o, p, "permeability_law", CASE_OPTIONAL,
 					     permeability_law_names, b->permeability_law);
+	return seeded;
 }
 
-static void read_bodies(struct case_reader *r, const json_t *root, struct case_spec *c, int grid_ok)
+/* Returns 1 when the list was there to be read (materials NULL: the materials' list was not). */
+static int read_bodies(struct case_reader *r, const json_t *root, struct case_spec *c, int grid_ok,
+		       const struct case_names *materials, struct case_names *names)
 {
 	size_t n;
-	const json_t *a = case_read_array(r, root, "", "bodies", CASE_REQUIRED, &n);
+	const json_t *a = case_read_list(r, root, "", "bodies", CASE_REQUIRED, CASE_BODIES_MAX, "bodies", &n);
 	if (a && n == 0)
 		case_problem(r, "/bodies", "must list at least one body");
 	if (!a || !(c->bodies = alloc_items(r, n, sizeof *c->bodies)))
-		return;
+		return a != NULL;
 	c->body_count = (int)n;
+	double points = 0, vertices = 0;
 	for (int i = 0; i < c->body_count; i++) {
 		char p[CASE_POINTER_MAX];
 		struct case_body *b = &c->bodies[i];
@@ -466,9 +339,15 @@ static void read_bodies(struct case_reader *r, const json_t *root, struct case_s
 		case_pointer_index(p, "/bodies", (size_t)i);
 		if (!case_expect_object(r, case_array_item(a, (size_t)i), p))
 			continue;
-		read_body(r, case_array_item(a, (size_t)i), p, c, grid_ok, b);
-		check_unique(r, "/bodies", i, "body", b->name, find_body(c, i, b->name));
+		if (read_body(r, case_array_item(a, (size_t)i), p, c, grid_ok, materials, b) && grid_ok)
+			points += case_body_points(&c->grid, b);
+		vertices += b->polygon_count;
+		check_unique(r, names, "/bodies", i, "body", b->name);
 	}
+	case_check_limit(r, "/bodies", "have", "polygon vertices in all", vertices, CASE_POLYGON_VERTICES_MAX);
+	case_check_limit(r, "/bodies", "seed", "material points (area / cell_size^2 x particles_per_cell^2)",
+			 points, CASE_POINTS_MAX);
+	return 1;
 }
 
 static void read_fluid(struct case_reader *r, const json_t *root, struct case_spec *c)
@@ -563,6 +442,8 @@ static void read_load_span(struct case_reader *r, const json_t *o, const char *p
 {
 	char pointer[CASE_POINTER_MAX], a[CASE_NUMBER_SIZE], b[CASE_NUMBER_SIZE], got[CASE_NUMBER_SIZE];
 	const struct case_body *body = known ? &c->bodies[l->body] : NULL;
+	if (body && !(body->min[0] < body->max[0] && body->min[1] < body->max[1]))
+		body = NULL;                  /* its region was refused: no face to default to or check */
 	int axis = l->face == FACE_LEFT || l->face == FACE_RIGHT; /* along the face: y for left/right */
 	double lo = body ? body->min[axis] : 0, hi = body ? body->max[axis] : 0;
 	l->from = lo;
@@ -578,7 +459,7 @@ static void read_load_span(struct case_reader *r, const json_t *o, const char *p
 			     case_format_number(a, l->from), case_format_number(got, l->to));
 		return;
 	}
-	double slack = GRID_TOLERANCE * c->grid.extent[axis];
+	double slack = CASE_GRID_TOLERANCE * c->grid.extent[axis];
 	if (body && (l->from < lo - slack || l->to > hi + slack))
 		case_problem(r, p, "from and to must lie on the %s face of body '%s', from %s to %s",
 			     face_names[l->face], body->name, case_format_number(a, lo),
@@ -586,7 +467,7 @@ static void read_load_span(struct case_reader *r, const json_t *o, const char *p
 }
 
 static void read_load(struct case_reader *r, const json_t *o, const char *p, const struct case_spec *c,
-		      struct case_load *l)
+		      const struct case_names *bodies, struct case_load *l)
 {
 	char pointer[CASE_POINTER_MAX], shown[CASE_QUOTE_SIZE];
 	const char *name;
@@ -594,9 +475,9 @@ static void read_load(struct case_reader *r, const json_t *o, const char *p, con
 	case_check_keys(r, o, p, load_keys);
 	l->body = -1;
 	if (case_read_string(r, o, p, "body", CASE_REQUIRED, &name)) {
-		l->body = find_body(c, c->body_count, name);
+		l->body = bodies ? case_names_find(bodies, name) : -1;   /* NULL: the bodies' list was not read */
 		case_pointer_key(pointer, p, "body");
-		if (l->body < 0)
+		if (l->body < 0 && bodies)
 			case_problem(r, pointer, "unknown body '%s'", case_quote(shown, name));
 	}
 	int face_ok = case_read_choice(r, o, p, "face", CASE_REQUIRED, face_names, &face);
@@ -607,10 +488,11 @@ static void read_load(struct case_reader *r, const json_t *o, const char *p, con
 	read_load_span(r, o, p, c, l->body >= 0 && face_ok, l);
 }
 
-static void read_loads(struct case_reader *r, const json_t *root, struct case_spec *c)
+static void read_loads(struct case_reader *r, const json_t *root, struct case_spec *c,
+		       const struct case_names *bodies)
 {
 	size_t n;
-	const json_t *a = case_read_array(r, root, "", "loads", CASE_OPTIONAL, &n);
+	const json_t *a = case_read_list(r, root, "", "loads", CASE_OPTIONAL, CASE_LOADS_MAX, "loads", &n);
 	if (!a || !(c->loads = alloc_items(r, n, sizeof *c->loads)))
 		return;
 	c->load_count = (int)n;
@@ -618,44 +500,61 @@ static void read_loads(struct case_reader *r, const json_t *root, struct case_sp
 		char p[CASE_POINTER_MAX];
 		case_pointer_index(p, "/loads", (size_t)i);
 		if (case_expect_object(r, case_array_item(a, (size_t)i), p))
-			read_load(r, case_array_item(a, (size_t)i), p, c, &c->loads[i]);
+			read_load(r, case_array_item(a, (size_t)i), p, c, bodies, &c->loads[i]);
 	}
 }
 
-static void read_time(struct case_reader *r, const json_t *root, struct case_spec *c)
+/* Returns 1 when dt and end were read and fit, so the frames and checkpoints can be counted. */
+static int read_time(struct case_reader *r, const json_t *root, struct case_spec *c)
 {
 	char end[CASE_NUMBER_SIZE], dt[CASE_NUMBER_SIZE];
 	const json_t *o = case_read_object(r, root, "", "time", CASE_REQUIRED);
 	if (!o)
-		return;
+		return 0;
 	case_check_keys(r, o, "/time", time_keys);
 	int ok = case_read_number(r, o, "/time", "dt", CASE_REQUIRED, &POSITIVE, &c->time.dt);
 	ok &= case_read_number(r, o, "/time", "end", CASE_REQUIRED, &POSITIVE, &c->time.end);
-	if (ok && c->time.dt > c->time.end)
+	if (ok && c->time.dt > c->time.end) {
 		case_problem(r, "/time/dt", "must be <= /time/end (%s), got %s",
 			     case_format_number(end, c->time.end), case_format_number(dt, c->time.dt));
+		return 0;
+	}
+	return ok && case_check_limit(r, "/time/end", "take", "steps of /time/dt", c->time.end / c->time.dt,
+				      CASE_STEPS_MAX);
 }
 
-static void read_output(struct case_reader *r, const json_t *root, struct case_spec *c)
+/* How many times something due every interval of simulated time happens in a run: at most once a
+ * step (run.c), whatever the interval. */
+static double events_in_run(const struct case_spec *c, double interval)
+{
+	return fmin(c->time.end / interval, ceil(c->time.end / c->time.dt));
+}
+
+static void read_output(struct case_reader *r, const json_t *root, struct case_spec *c, int time_ok)
 {
 	const json_t *o = case_read_object(r, root, "", "output", CASE_OPTIONAL);
 	if (!o)
 		return;
 	case_check_keys(r, o, "/output", output_keys);
-	case_read_number(r, o, "/output", "frame_interval", CASE_OPTIONAL, &NON_NEGATIVE,
-			 &c->output.frame_interval);
+	if (case_read_number(r, o, "/output", "frame_interval", CASE_OPTIONAL, &NON_NEGATIVE,
+			     &c->output.frame_interval) && c->output.frame_interval > 0 && time_ok)
+		case_check_limit(r, "/output/frame_interval", "give", "frames over /time/end",
+				 events_in_run(c, c->output.frame_interval), CASE_FRAMES_MAX);
 	case_read_number(r, o, "/output", "progress_interval", CASE_OPTIONAL, &POSITIVE,
 			 &c->output.progress_interval);
 }
 
 /* {"interval": s of simulated time}: absent means no checkpoints (interval 0). */
-static void read_checkpoint(struct case_reader *r, const json_t *root, struct case_spec *c)
+static void read_checkpoint(struct case_reader *r, const json_t *root, struct case_spec *c, int time_ok)
 {
 	const json_t *o = case_read_object(r, root, "", "checkpoint", CASE_OPTIONAL);
 	if (!o)
 		return;
 	case_check_keys(r, o, "/checkpoint", checkpoint_keys);
-	case_read_number(r, o, "/checkpoint", "interval", CASE_REQUIRED, &POSITIVE, &c->checkpoint.interval);
+	if (case_read_number(r, o, "/checkpoint", "interval", CASE_REQUIRED, &POSITIVE, &c->checkpoint.interval) &&
+	    time_ok)
+		case_check_limit(r, "/checkpoint/interval", "give", "checkpoints over /time/end",
+				 events_in_run(c, c->checkpoint.interval), CASE_CHECKPOINTS_MAX);
 }
 
 static void read_probe(struct case_reader *r, const json_t *o, const char *p, const struct case_spec *c,
@@ -673,13 +572,13 @@ static void read_probe(struct case_reader *r, const json_t *o, const char *p, co
 		probe->field = read_choice_or(r, o, p, "field", CASE_REQUIRED, probe_field_names,
 					      probe->field);
 		case_pointer_key(pointer, p, "box");
-		if (read_box(r, o, p, "box", probe->box_min, probe->box_max) && grid_ok)
-			check_inside_grid(r, pointer, "box", &c->grid, probe->box_min, probe->box_max);
+		if (case_read_box(r, o, p, "box", probe->box_min, probe->box_max) && grid_ok)
+			case_check_inside_grid(r, pointer, "box", &c->grid, probe->box_min, probe->box_max);
 		return;
 	}
 	case_pointer_key(pointer, p, "point");
 	if (case_read_vec2(r, o, p, "point", CASE_REQUIRED, NULL, probe->point) && grid_ok)
-		check_inside_grid(r, pointer, "point", &c->grid, probe->point, probe->point);
+		case_check_inside_grid(r, pointer, "point", &c->grid, probe->point, probe->point);
 	if (kind == PROBE_DISPLACEMENT)
 		probe->component = read_choice_or(r, o, p, "component", CASE_REQUIRED, component_names, 0);
 }
@@ -687,10 +586,12 @@ static void read_probe(struct case_reader *r, const json_t *o, const char *p, co
 static void read_probes(struct case_reader *r, const json_t *root, struct case_spec *c, int grid_ok)
 {
 	size_t n;
-	const json_t *a = case_read_array(r, root, "", "probes", CASE_OPTIONAL, &n);
+	struct case_names names;
+	const json_t *a = case_read_list(r, root, "", "probes", CASE_OPTIONAL, CASE_PROBES_MAX, "probes", &n);
 	if (!a || !(c->probes = alloc_items(r, n, sizeof *c->probes)))
 		return;
 	c->probe_count = (int)n;
+	case_names_init(r, &names);
 	for (int i = 0; i < c->probe_count; i++) {
 		char p[CASE_POINTER_MAX];
 		struct case_probe *probe = &c->probes[i];
@@ -698,8 +599,9 @@ static void read_probes(struct case_reader *r, const json_t *root, struct case_s
 		if (!case_expect_object(r, case_array_item(a, (size_t)i), p))
 			continue;
 		read_probe(r, case_array_item(a, (size_t)i), p, c, grid_ok, probe);
-		check_unique(r, "/probes", i, "probe", probe->name, find_probe(c, i, probe->name));
+		check_unique(r, &names, "/probes", i, "probe", probe->name);
 	}
+	case_names_release(&names);
 }
 
 static void set_defaults(struct case_spec *c)
@@ -738,16 +640,45 @@ static void read_case(struct case_reader *r, const json_t *root, struct case_spe
 	read_header(r, root, c);
 	read_formulation(r, root, &c->formulation);
 	int grid_ok = read_grid(r, root, &c->grid);
-	read_materials(r, root, c);
-	read_bodies(r, root, c, grid_ok);
+	struct case_names materials, bodies;
+	case_names_init(r, &materials);
+	case_names_init(r, &bodies);
+	int materials_read = read_materials(r, root, c, &materials);
+	int bodies_read = read_bodies(r, root, c, grid_ok, materials_read ? &materials : NULL, &bodies);
+	case_names_release(&materials);
 	read_fluid(r, root, c);
 	read_gravity(r, root, c);
 	read_boundaries(r, root, c->boundaries);
-	read_loads(r, root, c);
-	read_time(r, root, c);
-	read_output(r, root, c);
+	read_loads(r, root, c, bodies_read ? &bodies : NULL);
+	case_names_release(&bodies);
+	int time_ok = read_time(r, root, c);
+	read_output(r, root, c, time_ok);
 	read_probes(r, root, c, grid_ok);
-	read_checkpoint(r, root, c);
+	read_checkpoint(r, root, c, time_ok);
+}
+
+/* Reads the document root into a new case; its JSON text is text, or root in canonical form when
+ * text is NULL. */
+static enum poro_status load_root(struct case_reader *r, const json_t *root, const char *text,
+				  struct case_spec **out)
+{
+	struct case_spec *c = calloc(1, sizeof *c);
+	if (c) {
+		set_defaults(c);
+		read_case(r, root, c);
+	}
+	if (c && !r->out_of_memory && !r->problem_count && !(c->json = text ? strdup(text) : case_json_text(root)))
+		r->out_of_memory = 1;
+	if (!c || r->out_of_memory) {
+		case_destroy(&c);
+		return poro_error_set(r->err, PORO_ENOMEM, "out of memory loading a case");
+	}
+	if (r->problem_count) {
+		case_destroy(&c);
+		return PORO_EINVAL;
+	}
+	*out = c;
+	return PORO_OK;
 }
 
 enum poro_status case_load_string(const char *json, struct case_spec **out, struct poro_error *err)
@@ -759,24 +690,18 @@ enum poro_status case_load_string(const char *json, struct case_spec **out, stru
 	json_t *root = case_json_parse(&r, json);
 	if (!root)
 		return PORO_EINVAL;
-	struct case_spec *c = calloc(1, sizeof *c);
-	if (c) {
-		set_defaults(c);
-		read_case(&r, root, c);
-	}
+	enum poro_status status = load_root(&r, root, json, out);
 	case_json_free(root);
-	if (c && !r.out_of_memory && !r.problem_count && !(c->json = strdup(json)))
-		r.out_of_memory = 1;
-	if (!c || r.out_of_memory) {
-		case_destroy(&c);
-		return poro_error_set(err, PORO_ENOMEM, "out of memory loading a case");
-	}
-	if (r.problem_count) {
-		case_destroy(&c);
+	return status;
+}
+
+enum poro_status case_load_json(const json_t *root, struct case_spec **out, struct poro_error *err)
+{
+	struct case_reader r = { .err = err };
+	*out = NULL;
+	if (!case_json_root(&r, root))
 		return PORO_EINVAL;
-	}
-	*out = c;
-	return PORO_OK;
+	return load_root(&r, root, NULL, out);
 }
 
 enum poro_status case_read_text(const char *path, char **text, struct poro_error *err)

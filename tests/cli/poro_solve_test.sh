@@ -61,6 +61,26 @@ bad_input unknown_key "/time/dtt"
 bad_input body_outside_grid "/bodies/0"
 bad_input missing_material "/bodies/0/material"
 
+# ---- limits of a case (docs/case-spec.md "Limits"): the issue's 1.6e9 cells and end time of 1e12 s ----
+
+derive too_many_cells 'c["grid"]["extent"] = [1000.0, 1000.0]'
+derive endless 'c["time"]["end"] = 1e12; c["output"]["frame_interval"] = 0'
+bad_input too_many_cells "/grid"
+bad_input endless "/time/end"
+"$solve" validate "$tmp/too_many_cells.json" > /dev/null 2> "$tmp/err"
+grep -qx '/grid: must have at most 100000000 cells (the case limit), got 1600000000' "$tmp/err"
+check validate_names_the_cell_limit $? "stderr: $(head -c 300 "$tmp/err")"
+
+# ---- a case with 1000 problems lists the first 100 and counts the rest --------------------------
+
+derive many_problems 'c["probes"] = [{"name": "p%d" % i, "kind": "pore_pressure"} for i in range(1000)]'
+"$solve" validate "$tmp/many_problems.json" > /dev/null 2> "$tmp/err"
+rc=$?
+listed=$(grep -c '^/probes/[0-9]*/point: missing required key$' "$tmp/err")
+grep -qx '\.\.\. and 900 more problems' "$tmp/err"
+check validate_caps_the_problems_and_counts_the_rest $(( rc != 2 || listed != 100 || $? != 0 )) \
+	"exit $rc, $listed problems listed, last line: $(tail -1 "$tmp/err")"
+
 # ---- a file that does not exist: exit 4 naming the path ---------------------------------------
 
 absent="$tmp/no_such_case.json"
