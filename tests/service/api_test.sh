@@ -304,9 +304,10 @@ code=$(svc_req GET "/v1/worker/jobs/$cid/files/result.h5" "$worker")
 [ "$code" = 200 ] && cmp -s "$SVC_BODY" "$tmp/result.h5" && [ "$(svc_header X-Checksum-Sha256)" = "$fsha" ]
 check worker_download_200 $? "status $code"
 
+# the server never reads result.h5: probes come from the probes.json a worker uploads
 code=$(svc_req GET "/v1/jobs/$cid/probes" "$alice")
-expect_error probes_of_unreadable_result_500 500 internal "" "$code"
-grep -q "cannot read the result of job $cid" "$SVC_BODY"
+expect_error probes_without_probes_json_404 404 not_found "" "$code"
+grep -q "job $cid has no probes yet" "$SVC_BODY"
 check probes_error_names_the_job $? "$(head -c 300 "$SVC_BODY")"
 
 sleep 0.3
