@@ -39,6 +39,10 @@ CLIENT_OBJ = $(patsubst %.c,$(BUILD)/%.o,$(wildcard client/*.c))
 SERVER_OBJ = $(patsubst %.c,$(BUILD)/%.o,$(wildcard server/*.c))
 WORKER_OBJ = $(patsubst %.c,$(BUILD)/%.o,$(wildcard worker/*.c))
 SVC_LIBS   = -ljansson -lcrypto -lpthread
+# poro-server links libporo.a for case validation only, and never HDF5: it does not read result files
+# (probes come from `poro-solve probes`, run by the worker), so a damaged file cannot crash it.
+# tests/service/integrity_test.sh checks with ldd that no libhdf5 is linked.
+SERVER_LIBS = -lmicrohttpd -lsqlite3 -lm $(SVC_LIBS)
 SERVICE    = $(if $(SERVER_OBJ),$(BUILD)/poro-server) $(if $(WORKER_OBJ),$(BUILD)/poro-worker) \
 	     $(if $(CLIENT_OBJ),$(BUILD)/poro $(BUILD)/poro-load)
 
@@ -95,7 +99,7 @@ $(BUILD)/bench/%: $(BUILD)/bench/%.o $(LIBPORO)
 	$(CC) $(LDFLAGS) $^ $(LDLIBS) -o $@
 
 $(BUILD)/poro-server: $(SERVER_OBJ) $(COMMON_OBJ) $(LIBPORO)
-	$(CC) $(LDFLAGS) $^ $(LDLIBS) -lmicrohttpd -lsqlite3 $(SVC_LIBS) -o $@
+	$(CC) $(LDFLAGS) $^ $(SERVER_LIBS) -o $@
 
 $(BUILD)/poro-worker: $(WORKER_OBJ) $(CLIENT_OBJ) $(COMMON_OBJ)
 	$(CC) $(LDFLAGS) $^ -lcurl $(SVC_LIBS) -o $@

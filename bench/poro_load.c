@@ -13,7 +13,8 @@
  *       a client relying on Idempotency-Key would; each try is recorded. Latency is the last try's.
  *       --pause-ms makes each client wait between its submissions (a paced load for crash tests).
  *   poro-load claim --server URL --token WORKER_TOKEN --count N --clients C
- *       claims jobs and finishes each at once as "succeeded"; prints claims per second and claim
+ *       claims jobs and finishes each at once as "failed" (a success would need a stored result.h5,
+ *       docs/service.md §3); prints claims per second and claim
  *       latency percentiles. A client stops when the queue stays empty for one short long-poll.
  *
  * Failures are counted, never fatal: the tool keeps going when the server disappears. Latency
@@ -150,7 +151,7 @@ static void *claim_client(void *arg)
 		char path[128];
 		snprintf(path, sizeof path, "/v1/worker/jobs/%lld/finish", json_get_int(job, "id", -1));
 		json_t *fin = json_pack("{s:I, s:s, s:n, s:i}", "attempt", (json_int_t)json_get_int(job, "attempt", 0),
-					"outcome", "succeeded", "message", "exit_code", 0);
+					"outcome", "failed", "message", "exit_code", 0);
 		struct http_response f;
 		http_json(c, "POST", path, fin, NULL, 30, &f);
 		json_decref(fin);

@@ -505,6 +505,11 @@ static int fetch_file(long long id, const json_t *job, const char *name, const c
 	struct http_response r;
 	long long size = 0;
 	http_download(http, path, part, sha, &size, &r);
+	if (r.status == 0) {
+		/* broken off mid-way: asked again, a server that cut a damaged file says so at once */
+		http_response_release(&r);
+		http_download(http, path, part, sha, &size, &r);
+	}
 	if (!http_ok(&r))
 		return fail(&r);
 	http_response_release(&r);

@@ -15,6 +15,11 @@
  *                                        gap, oscillation index) to stdout or FILE, and the pore
  *                                        pressure along a line at the frame nearest TIME (default the
  *                                        last) to the --line-out FILE
+ *   poro-solve probes RESULT.h5 --job ID --attempt N [--out FILE]
+ *                                        the probe series of a run as the JSON document the job
+ *                                        service serves (docs/service.md §3, GET .../probes):
+ *                                        {"job", "attempt", "probes": {name: {"unit", "time",
+ *                                        "value"}}}, names in the order of the case, to stdout or FILE
  *   poro-solve version
  *
  * run writes DIR/checkpoint.h5 every checkpoint.interval of simulated time (case key) and every
@@ -22,6 +27,11 @@
  * "checkpoint step=N time=T" after each; --resume continues from such a checkpoint, keeping the
  * frames of DIR/result.h5 up to it (checkpoint.h, docs/service.md §2). A checkpoint of another
  * case is refused with exit 2, naming the first difference.
+ *
+ * probes runs in its own process because a result file is untrusted input for whoever reads it: the
+ * worker runs it on each result.h5 it uploads, so a damaged file can crash only this process, never
+ * the server (which no longer links HDF5). Numbers are written with 17 significant digits, so they
+ * read back to the same doubles; a value that is not finite is written as null (JSON has no NaN).
  *
  * Exit codes come from the status table in error.h: 0 success, 2 invalid input, 3 solver failure
  * (NaN, a point leaving the grid, a failed factorisation), 4 I/O, 5 out of memory, 6 interrupted.
@@ -39,6 +49,7 @@
 #include "element.h"
 #include "poro.h"
 #include "report.h"
+#include "results_read.h"
 
 #ifndef PORO_VERSION
 #define PORO_VERSION "unknown"
@@ -59,6 +70,7 @@ static int usage(void)
 			"       poro-solve element CASE.json --out DIR\n"
 			"       poro-solve report RESULT.h5 [--out FILE] [--ground Y] [--crest X] [--tolerance M]\n"
 			"                         [--line X0,Y0,X1,Y1[,...][,N] --line-out FILE [--at TIME]]\n"
+			"       poro-solve probes RESULT.h5 --job ID --attempt N [--out FILE]\n"
 			"       poro-solve version\n");
 	return 2;
 }
@@ -314,6 +326,138 @@ static int parse_report(int argc, char **argv)
 	return cmd_report(argv[2], &opt);
 }
 
+/* ---- probes ---------------------------------------------------------------------------------- */
+
+/* Writes text as a JSON string. Probe names come from the case, which jansson has read, so they are
+ * valid UTF-8; units are the solver's ASCII names, and any other byte in them is a damaged file's,
+ * written as '?' so the document stays valid UTF-8 whatever the file holds. */
+static void write_json_string(FILE *f, const char *text, int ascii_only)
+{
+	fputc('"', f);
+	for (const unsigned char *p = (const unsigned char *)text; *p; p++) {
+		if (*p == '"' || *p == '\\')
+			fprintf(f, "\\%c", *p);
+		else if (*p < 0x20)
+			fprintf(f, "\\u%04x", *p);
+		else
+			fputc(ascii_only && *p >= 0x7f ? '?' : *p, f);
+	}
+	fputc('"', f);
+}
+
+static void write_json_numbers(FILE *f, const double *x, long n)
+{
+	fputc('[', f);
+	for (long k = 0; k < n; k++) {
+		if (k)
+			fputc(',', f);
+		if (!isfinite(x[k])) {
+			fputs("null", f);
+			continue;
+		}
+		char text[32];   /* the shortest of 15, 16, 17 digits that reads back to x[k] */
+		for (int digits = 15; digits <= 17; digits++) {
+			snprintf(text, sizeof text, "%.*g", digits, x[k]);
+			if (strtod(text, NULL) == x[k])
+				break;
+		}
+		fputs(text, f);
+	}
+	fputc(']', f);
+}
+
+/* The "probes" object: each probe of the case, in its order, read from the file. */
+static enum poro_status write_probes(FILE *f, struct results *res, const struct case_spec *c,
+				     struct poro_error *err)
+{
+	fputs("\"probes\": {", f);
+	for (int i = 0; i < c->probe_count; i++) {
+		double *t = NULL, *v = NULL;
+		char *units = NULL;
+		long n = 0;
+		enum poro_status st = results_probe_read(res, c->probes[i].name, &t, &v, &n, &units, err);
+		if (st)
+			return st;
+		if (i)
+			fputs(", ", f);
+		write_json_string(f, c->probes[i].name, 0);
+		fputs(": {\"unit\": ", f);
+		write_json_string(f, units ? units : "", 1);
+		fputs(", \"time\": ", f);
+		write_json_numbers(f, t, n);
+		fputs(", \"value\": ", f);
+		write_json_numbers(f, v, n);
+		fputc('}', f);
+		free(t), free(v), free(units);
+	}
+	fputs("}", f);
+	return PORO_OK;
+}
+
+/* probes RESULT.h5: the whole document, or nothing (an --out FILE is removed) when the file cannot be
+ * read. The case comes from the file itself, so its probe order is the run's. */
+static int cmd_probes(const char *path, long long job, long long attempt, const char *out)
+{
+	struct poro_error err = {0};
+	struct results *res = NULL;
+	struct case_spec *c = NULL;
+	enum poro_status st = results_check_file(path, &err);
+	if (!st)
+		st = results_open(&res, path, &err);
+	if (!st)
+		st = case_load_string(results_case_json(res), &c, &err);
+	FILE *f = NULL;
+	if (!st && !(f = out ? create_output(out) : stdout)) {
+		results_close(&res);
+		case_destroy(&c);
+		return poro_status_exit_code(PORO_EIO);
+	}
+	if (!st) {
+		fprintf(f, "{\"job\": %lld, \"attempt\": %lld, ", job, attempt);
+		st = write_probes(f, res, c, &err);
+		fputs("}\n", f);
+		if (!st && (fflush(f) != 0 || ferror(f)))
+			st = poro_error_set(&err, PORO_EIO, "cannot write '%s': %s", out ? out : "stdout", strerror(errno));
+	}
+	if (out && f && fclose(f) != 0 && !st)
+		st = poro_error_set(&err, PORO_EIO, "cannot write '%s': %s", out, strerror(errno));
+	if (st && out && f)
+		remove(out);
+	results_close(&res);
+	case_destroy(&c);
+	return st ? fail(st, &err, path) : 0;
+}
+
+/* An integer option value in [0, 10^18]; -1 after saying why not. */
+static int parse_count(const char *key, const char *text, long long *value)
+{
+	char *end;
+	errno = 0;
+	*value = strtoll(text, &end, 10);
+	if (errno || end == text || *end || *value < 0 || *value > 1000000000000000000LL) {
+		fprintf(stderr, "poro-solve: %s: '%s' is not a whole number >= 0\n", key, text);
+		return -1;
+	}
+	return 0;
+}
+
+/* probes RESULT.h5 --job ID --attempt N [--out FILE], options in any order. */
+static int parse_probes(int argc, char **argv)
+{
+	long long job = -1, attempt = -1;
+	const char *out = NULL;
+	for (int i = 3; i < argc; i += 2) {
+		const char *key = argv[i], *value = i + 1 < argc ? argv[i + 1] : NULL;
+		if (!value || (strcmp(key, "--job") && strcmp(key, "--attempt") && strcmp(key, "--out")))
+			return usage();
+		if (!strcmp(key, "--out"))
+			out = value;
+		else if (parse_count(key, value, !strcmp(key, "--job") ? &job : &attempt))
+			return 2;
+	}
+	return job < 0 || attempt < 0 ? usage() : cmd_probes(argv[2], job, attempt, out);
+}
+
 int main(int argc, char **argv)
 {
 	if (argc >= 2 && !strcmp(argv[1], "version")) {
@@ -326,6 +470,8 @@ int main(int argc, char **argv)
 		return parse_run(argc, argv);
 	if (argc >= 3 && !strcmp(argv[1], "report"))
 		return parse_report(argc, argv);
+	if (argc >= 3 && !strcmp(argv[1], "probes"))
+		return parse_probes(argc, argv);
 	if (argc == 5 && !strcmp(argv[1], "element") && !strcmp(argv[3], "--out"))
 		return cmd_element(argv[2], argv[4]);
 	return usage();

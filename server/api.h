@@ -29,6 +29,18 @@ int files_upload_data(struct request *r, const char *data, size_t size);
 void files_upload_end(struct request *r);
 void files_upload_abort(struct request *r);
 
+/* An indexed stored file (store_file_find). */
+struct stored_file {
+	long long id;
+	int attempt;
+	const char *name;
+	long long size;                   /* bytes, as indexed */
+	const char *sha256;               /* as indexed */
+};
+/* Answers with the stored file, checked against its index row on the way (files_serve.c): its
+ * size always, its SHA-256 for whole-file downloads; a damaged copy is 500 stored_file_damaged. */
+void files_serve(struct request *r, const struct stored_file *f, const char *content_type);
+
 /* operators */
 void admin_healthz(struct request *r);
 void admin_metrics(struct request *r);
@@ -52,6 +64,8 @@ int api_query_int(struct request *r, const char *name, long long min, long long 
 /* File names: ^[A-Za-z0-9][A-Za-z0-9._-]{0,127}$ and no "..". Decodes the raw path element into
  * out[129]; 0, or -1 after replying 400 invalid_file_name. */
 int api_file_name(struct request *r, const char *raw, char out[129]);
+/* 1 when a decoded name follows the rule of api_file_name (for names inside JSON bodies). */
+int api_file_name_valid(const char *name);
 /* The job {id} of the path exists and the caller may see it: 0, or -1 after replying (404 for
  * another user's job, as for a missing one). */
 int api_job_visible(struct request *r);

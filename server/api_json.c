@@ -138,14 +138,20 @@ int api_query_int(struct request *r, const char *name, long long min, long long 
 
 #define FILE_NAME_MAX 128
 
-int api_file_name(struct request *r, const char *raw, char out[FILE_NAME_MAX + 1])
+int api_file_name_valid(const char *name)
 {
-	int ok = raw && http_decode(raw, out, FILE_NAME_MAX + 1) == 0 && out[0] && strstr(out, "..") == NULL;
-	for (size_t i = 0; ok && out[i]; i++) {
-		char c = out[i];
+	int ok = name[0] && strlen(name) <= FILE_NAME_MAX && strstr(name, "..") == NULL;
+	for (size_t i = 0; ok && name[i]; i++) {
+		char c = name[i];
 		int alnum = (c >= 'A' && c <= 'Z') || (c >= 'a' && c <= 'z') || (c >= '0' && c <= '9');
 		ok = alnum || (i > 0 && (c == '.' || c == '_' || c == '-'));
 	}
+	return ok;
+}
+
+int api_file_name(struct request *r, const char *raw, char out[FILE_NAME_MAX + 1])
+{
+	int ok = raw && http_decode(raw, out, FILE_NAME_MAX + 1) == 0 && api_file_name_valid(out);
 	if (!ok) {
 		reply_fail(r, API_INVALID_FILE_NAME, "name",
 			   "file name must match ^[A-Za-z0-9][A-Za-z0-9._-]{0,127}$ and not contain '..'");

@@ -9,15 +9,21 @@
  * write, only if the attempt still holds the lease (store_file_commit). A file without an index
  * row is never served. Names are checked before anything touches the disk (api_file_name).
  *
- * Downloads send X-Checksum-Sha256 and honour one HTTP byte range (206, or 416 when it starts past
- * the end); a list of ranges or a malformed one is ignored and the whole file sent, as RFC 9110
- * allows.
+ * probes.json is the one file whose content the server checks: it is served as the answer of GET
+ * /v1/jobs/{id}/probes, so it must be one JSON object. json_scan checks it while it streams in, in
+ * constant memory, within JSON_FILE_MAX_BYTES (or --max-upload-bytes when smaller), a nesting depth
+ * and a token length; a file that fails is 422 invalid_json_file naming the byte, and is not
+ * stored. The server never parses result files (docs/service.md §3, "Probes").
+ *
+ * Downloads (files_serve.c) send X-Checksum-Sha256, honour one byte range and check the copy on
+ * disk against its index row.
  */
 #include "api.h"
 #include "store.h"
 
 #include "digest.h"
 #include "fs.h"
+#include "json_scan.h"
 
 #include <errno.h>
 #include <fcntl.h>
@@ -29,12 +35,19 @@
 
 #define ATTEMPT_MAX 1000000
 #define NAME_SIZE 129
+#define JSON_FILE_NAME "probes.json"
+#define JSON_FILE_MAX_BYTES (256LL << 20) /* bytes: 3 probes of 2 million steps (120 bytes a step) */
+#define JSON_FILE_DEPTH_MAX 16            /* the probes document nests 4 deep */
+#define JSON_FILE_TOKEN_MAX 4096          /* bytes of one string or number */
 
 struct upload {
 	int fd;
 	struct digest *digest;
-	long long size, id;
+	long long size, id, limit;
 	int attempt, committed;
+	int json;                     /* a JSON file: scan holds the check so far */
+	int json_started;             /* its first non-blank byte has been seen */
+	struct json_scan scan;
 	char name[NAME_SIZE];
 	char expected[DIGEST_HEX_SIZE];
 	char tmp[SERVER_PATH_MAX + 256], final[SERVER_PATH_MAX + 256];
@@ -56,6 +69,48 @@ static int checksum_header(struct request *r, char out[DIGEST_HEX_SIZE])
 	return ok ? 0 : -1;
 }
 
+/* A file the server serves as JSON is checked as it arrives: 0, or -1 after replying 413. */
+static int json_file_begin(struct request *r, struct upload *u)
+{
+	if (strcmp(u->name, JSON_FILE_NAME) != 0)
+		return 0;
+	u->json = 1;
+	u->limit = JSON_FILE_MAX_BYTES < r->srv->cfg.max_upload_bytes ? JSON_FILE_MAX_BYTES : r->srv->cfg.max_upload_bytes;
+	json_scan_init(&u->scan, &(struct json_limits){ .max_depth = JSON_FILE_DEPTH_MAX, .max_values = u->limit,
+							 .max_token_bytes = JSON_FILE_TOKEN_MAX });
+	if (r->content_length > u->limit) {
+		reply_fail(r, API_TOO_LARGE, "", "'%s' of %lld bytes exceeds the limit of %lld bytes for JSON files",
+			   u->name, r->content_length, u->limit);
+		return -1;
+	}
+	return 0;
+}
+
+/* The next piece of a JSON file: 0, or -1 after replying 422 (or 413 past the limit). */
+static int json_file_feed(struct request *r, struct upload *u, const char *data, size_t size)
+{
+	if (u->size > u->limit) {
+		reply_fail(r, API_TOO_LARGE, "", "'%s' exceeds the limit of %lld bytes for JSON files", u->name, u->limit);
+		return -1;
+	}
+	for (size_t i = 0; !u->json_started && i < size; i++) {
+		unsigned char c = (unsigned char)data[i];
+		if (c == ' ' || c == '\t' || c == '\n' || c == '\r')
+			continue;
+		u->json_started = 1;
+		if (c != '{') {
+			reply_fail(r, API_INVALID_JSON_FILE, "", "'%s' must be a JSON object: byte %lld is 0x%02x, not '{'",
+				   u->name, u->size - (long long)size + (long long)i, c);
+			return -1;
+		}
+	}
+	if (json_scan_feed(&u->scan, data, size) != 0) {
+		reply_fail(r, API_INVALID_JSON_FILE, "", "'%s' is not a valid JSON file: %s", u->name, u->scan.error);
+		return -1;
+	}
+	return 0;
+}
+
 void files_upload_begin(struct request *r)
 {
 	struct upload *u = calloc(1, sizeof *u);
@@ -72,7 +127,7 @@ void files_upload_begin(struct request *r)
 		reply_fail(r, API_INVALID_PARAMETER, "attempt", "query parameter 'attempt' is required");
 		return;
 	}
-	if (checksum_header(r, u->expected))
+	if (checksum_header(r, u->expected) || json_file_begin(r, u))
 		return;
 	u->id = r->id;
 	u->attempt = (int)attempt;
@@ -100,6 +155,8 @@ int files_upload_data(struct request *r, const char *data, size_t size)
 	struct upload *u = r->upload;
 	digest_update(u->digest, data, size);
 	u->size += (long long)size;
+	if (u->json && json_file_feed(r, u, data, size))
+		return -1;
 	while (size) {
 		ssize_t n = write(u->fd, data, size);
 		if (n < 0 && errno == EINTR)
@@ -123,6 +180,11 @@ void files_upload_end(struct request *r)
 		reply_fail(r, API_CHECKSUM_MISMATCH, "X-Checksum-Sha256",
 			   "body of %lld bytes has SHA-256 %s, the header says %s", u->size, got, u->expected);
 		return; /* files_upload_abort removes the temporary file */
+	}
+	if (u->json && (!u->json_started || json_scan_finish(&u->scan) != 0)) {
+		reply_fail(r, API_INVALID_JSON_FILE, "", "'%s' is not a valid JSON file: %s", u->name,
+			   u->json_started ? u->scan.error : "it is empty");
+		return;
 	}
 	int synced = fsync(u->fd) == 0;
 	close(u->fd);
@@ -155,73 +217,7 @@ void files_upload_abort(struct request *r)
 	r->upload = NULL;
 }
 
-/* ---- downloads ---- */
-
-/* Parses a single "bytes=a-b" / "bytes=a-" / "bytes=-n" range: 1 and [*from, *to] when it
- * applies, 0 to send the whole file, -1 when it cannot be satisfied. */
-static int parse_range(const char *h, long long size, long long *from, long long *to)
-{
-	if (!h || strncmp(h, "bytes=", 6) != 0 || strchr(h, ','))
-		return 0;
-	const char *p = h + 6;
-	char *end;
-	if (*p == '-') {
-		long long n = strtoll(p + 1, &end, 10);
-		if (*end || n <= 0 || p[1] < '0' || p[1] > '9')
-			return n == 0 && !*end ? -1 : 0;
-		*from = n >= size ? 0 : size - n;
-		*to = size - 1;
-		return size > 0 ? 1 : -1;
-	}
-	if (*p < '0' || *p > '9')
-		return 0;
-	*from = strtoll(p, &end, 10);
-	if (*end != '-')
-		return 0;
-	if (end[1] == '\0') {
-		*to = size - 1;
-	} else {
-		char *end2;
-		*to = strtoll(end + 1, &end2, 10);
-		if (*end2 || end[1] < '0' || end[1] > '9' || *to < *from)
-			return 0;
-		if (*to >= size)
-			*to = size - 1;
-	}
-	return *from < size ? 1 : -1;
-}
-
-static void serve_file(struct request *r, long long id, int attempt, const char *name, long long size,
-		       const char *sha256)
-{
-	char path[SERVER_PATH_MAX];
-	snprintf(path, sizeof path, "%s/files/%lld/%d/%s", r->srv->cfg.state, id, attempt, name);
-	int fd = open(path, O_RDONLY);
-	if (fd < 0) {
-		reply_fail(r, API_INTERNAL, "", "indexed file '%s' of job %lld cannot be opened: %s", name, id,
-			   strerror(errno));
-		return;
-	}
-	long long from = 0, to = size - 1;
-	int ranged = parse_range(http_header(r, "Range"), size, &from, &to);
-	char text[96];
-	if (ranged < 0) {
-		close(fd);
-		snprintf(text, sizeof text, "bytes */%lld", size);
-		reply_header(r, "Content-Range", text);
-		reply_fail(r, API_RANGE, "Range", "range '%s' is outside the file's %lld bytes", http_header(r, "Range"),
-			   size);
-		return;
-	}
-	reply_fd(r, ranged ? 206 : 200, fd, from, ranged ? to - from + 1 : size);
-	r->reply.content_type = "application/octet-stream";
-	reply_header(r, "Accept-Ranges", "bytes");
-	reply_header(r, "X-Checksum-Sha256", sha256);
-	if (ranged) {
-		snprintf(text, sizeof text, "bytes %lld-%lld/%lld", from, to, size);
-		reply_header(r, "Content-Range", text);
-	}
-}
+/* ---- downloads (checked in files_serve.c) ---- */
 
 void files_get(struct request *r)
 {
@@ -237,7 +233,7 @@ void files_get(struct request *r)
 		reply_error(r, &err);
 		return;
 	}
-	serve_file(r, r->id, attempt, name, size, sha);
+	files_serve(r, &(struct stored_file){ r->id, attempt, name, size, sha }, "application/octet-stream");
 }
 
 void worker_file_get(struct request *r)
@@ -253,5 +249,5 @@ void worker_file_get(struct request *r)
 		reply_error(r, &err);
 		return;
 	}
-	serve_file(r, r->id, attempt, name, size, sha);
+	files_serve(r, &(struct stored_file){ r->id, attempt, name, size, sha }, "application/octet-stream");
 }

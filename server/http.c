@@ -192,6 +192,7 @@ static void reply_reset(struct reply *rep)
 	if (rep->stream && rep->stream_free)
 		rep->stream_free(rep->stream_cls);
 	rep->stream = NULL;
+	rep->stream_length = 0;
 	for (int i = 0; i < rep->header_count; i++) {
 		free(rep->headers[i][0]);
 		free(rep->headers[i][1]);
@@ -279,6 +280,13 @@ void reply_stream(struct request *r, int status, const char *content_type, strea
 	r->reply.stream_free = free_cls;
 }
 
+void reply_stream_sized(struct request *r, int status, const char *content_type, long long length, stream_fn fn,
+			void *cls, void (*free_cls)(void *cls))
+{
+	reply_stream(r, status, content_type, fn, cls, free_cls);
+	r->reply.stream_length = length;
+}
+
 /* ---- responses ---- */
 
 static ssize_t stream_adapter(void *cls, uint64_t pos, char *buf, size_t max)
@@ -315,8 +323,8 @@ static enum MHD_Result queue_reply(struct exchange *x)
 		}
 		*moved = *rep;
 		rep->stream = NULL; /* now owned by the response */
-		resp = MHD_create_response_from_callback(MHD_SIZE_UNKNOWN, STREAM_BLOCK, stream_adapter, moved,
-							 stream_release);
+		uint64_t length = rep->stream_length > 0 ? (uint64_t)rep->stream_length : MHD_SIZE_UNKNOWN;
+		resp = MHD_create_response_from_callback(length, STREAM_BLOCK, stream_adapter, moved, stream_release);
 		if (!resp)
 			stream_release(moved);
 	} else if (rep->fd >= 0) {

@@ -32,7 +32,8 @@ struct reply {
 	const char *content_type;
 	int fd;                           /* file reply: open descriptor (owned), or -1 */
 	long long fd_offset, fd_size;
-	stream_fn stream;                 /* streamed reply (chunked) */
+	stream_fn stream;                 /* streamed reply (chunked unless stream_length > 0) */
+	long long stream_length;          /* > 0: the stream's exact length in bytes (Content-Length) */
 	void *stream_cls;
 	void (*stream_free)(void *cls);
 	int header_count;
@@ -77,6 +78,10 @@ void reply_text(struct request *r, int status, const char *content_type, char *o
 void reply_fd(struct request *r, int status, int fd, long long offset, long long size);
 void reply_stream(struct request *r, int status, const char *content_type, stream_fn fn, void *cls,
 		  void (*free_cls)(void *cls));
+/* A stream of exactly length bytes, sent with Content-Length: a stream that fails before its end
+ * leaves the client a short body it can tell from a whole one. */
+void reply_stream_sized(struct request *r, int status, const char *content_type, long long length, stream_fn fn,
+			void *cls, void (*free_cls)(void *cls));
 void reply_header(struct request *r, const char *name, const char *value);
 
 /* What a route's request body may be (docs/service.md §3 "Limits"): each kind has its own largest

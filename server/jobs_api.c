@@ -1,6 +1,6 @@
 /*
  * jobs_api.c - the users' job routes (docs/service.md §3 "Users"): submit, list, show, cancel,
- * probes (read from the job's latest result.h5 through the solver's results reader).
+ * probes (the probes.json a worker extracted from result.h5, served as stored).
  *
  * A submission is checked completely before anything is stored: the request keys and ranges
  * (422 naming the key; threads also against --max-job-threads), then the case with the solver's
@@ -17,7 +17,6 @@
 
 #include "case.h"
 #include "digest.h"
-#include "results_read.h"
 
 #include <stdio.h>
 #include <stdlib.h>
@@ -252,63 +251,25 @@ void jobs_cancel(struct request *r)
 	reply_json(r, 200, job);
 }
 
-/* Adds {"unit", "time", "value"} of probe `name` to out, or records why it cannot. */
-static int add_probe(struct results *res, const char *name, json_t *out, struct poro_error *perr)
-{
-	double *t = NULL, *v = NULL;
-	char *units = NULL;
-	long n = 0;
-	if (results_probe_read(res, name, &t, &v, &n, &units, perr))
-		return -1;
-	json_t *times = json_array(), *values = json_array();
-	for (long k = 0; k < n; k++) {
-		json_array_append_new(times, json_real(t[k]));
-		json_array_append_new(values, json_real(v[k]));
-	}
-	json_object_set_new(out, name, json_pack("{s:s, s:o, s:o}", "unit", units ? units : "", "time", times,
-						 "value", values));
-	free(t), free(v), free(units);
-	return 0;
-}
-
-/* The probe series of the job's latest result.h5, for plots: {"job", "attempt", "probes": {name: {"unit",
- * "time", "value"}}} with names in the order of the case. A job without a result file yet is 404. */
+/* The probe series of the job's newest attempt that has them, for plots: the probes.json the worker
+ * extracted from result.h5 with `poro-solve probes` (in its own process: the server never parses a
+ * result file) and uploaded, checked as JSON at upload, sent as stored and checked like any stored
+ * file. A job without probes.json yet is 404 saying so. */
 void jobs_probes(struct request *r)
 {
 	if (api_job_visible(r))
 		return;
 	int attempt;
 	long long size;
-	char sha[DIGEST_HEX_SIZE], path[SERVER_PATH_MAX];
+	char sha[DIGEST_HEX_SIZE];
 	struct api_error err = { 0 };
-	if (store_file_find(r->srv->store, r->id, "result.h5", -1, &attempt, &size, sha, &err) != API_OK) {
-		reply_fail(r, API_NOT_FOUND, "", "job %lld has no result.h5 yet", r->id);
-		return;
-	}
-	snprintf(path, sizeof path, "%s/files/%lld/%d/result.h5", r->srv->cfg.state, r->id, attempt);
-	struct results *res = NULL;
-	struct poro_error perr = { 0 };
-	if (results_open(&res, path, &perr)) {
-		reply_fail(r, API_INTERNAL, "", "cannot read the result of job %lld: %s", r->id, perr.message);
-		return;
-	}
-	json_t *the_case = json_loads(results_case_json(res), 0, NULL);
-	json_t *list = json_object_get(the_case, "probes"), *probes = json_object(), *item;
-	size_t i;
-	int failed = 0;
-	json_array_foreach(list, i, item) {
-		const char *name = json_string_value(json_object_get(item, "name"));
-		if (name && add_probe(res, name, probes, &perr) < 0) {
-			failed = 1;
-			break;
+	if (store_file_find(r->srv->store, r->id, "probes.json", -1, &attempt, &size, sha, &err) != API_OK) {
+		if (err.code != API_NOT_FOUND) {
+			reply_error(r, &err);
+			return;
 		}
-	}
-	json_decref(the_case);
-	results_close(&res);
-	if (failed) {
-		json_decref(probes);
-		reply_fail(r, API_INTERNAL, "", "cannot read the probes of job %lld: %s", r->id, perr.message);
+		reply_fail(r, API_NOT_FOUND, "", "job %lld has no probes yet: no attempt has uploaded probes.json", r->id);
 		return;
 	}
-	reply_json(r, 200, json_pack("{s:I, s:i, s:o}", "job", (json_int_t)r->id, "attempt", attempt, "probes", probes));
+	files_serve(r, &(struct stored_file){ r->id, attempt, "probes.json", size, sha }, "application/json");
 }

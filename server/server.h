@@ -67,17 +67,20 @@ struct server_config {
 	X(API_STALE_ATTEMPT,        409, "stale_attempt")                    \
 	X(API_LOG_GAP,              409, "log_gap")                          \
 	X(API_ALREADY_EXISTS,       409, "already_exists")                   \
+	X(API_ARTIFACT_MISSING,     409, "artifact_missing")                 \
 	X(API_TOO_LARGE,            413, "body_too_large")                   \
 	X(API_BODY_TOO_COMPLEX,     413, "body_too_complex")                 \
 	X(API_URI_TOO_LONG,         414, "uri_too_long")                     \
 	X(API_RANGE,                416, "range_not_satisfiable")            \
 	X(API_INVALID_REQUEST,      422, "invalid_request")                  \
 	X(API_INVALID_CASE,         422, "invalid_case")                     \
+	X(API_INVALID_JSON_FILE,    422, "invalid_json_file")                \
 	X(API_QUOTA_EXCEEDED,       429, "quota_exceeded")                   \
 	X(API_TOO_MANY_REQUESTS,    429, "too_many_requests")                \
 	X(API_TOO_MANY_CONNECTIONS, 429, "too_many_connections")             \
 	X(API_HEADERS_TOO_LARGE,    431, "header_fields_too_large")          \
 	X(API_INTERNAL,             500, "internal")                         \
+	X(API_STORED_FILE_DAMAGED,  500, "stored_file_damaged")              \
 	X(API_NOT_IMPLEMENTED,      501, "not_implemented")                  \
 	X(API_UNAVAILABLE,          503, "unavailable")                      \
 	X(API_VERSION_NOT_SUPPORTED, 505, "http_version_not_supported")

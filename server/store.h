@@ -112,11 +112,20 @@ enum api_code store_file_commit(struct store *s, const struct principal *who, lo
 /* The newest indexed version of a file of a job with attempt <= max_attempt (any when < 0). */
 enum api_code store_file_find(struct store *s, long long id, const char *name, int max_attempt, int *attempt,
 			      long long *size, char sha256[65], struct api_error *err);
+/* A file a finishing worker declares it stored for the attempt. */
+struct finish_artifact {
+	const char *name;
+	long long size;             /* bytes */
+	const char *sha256;         /* 64 lower-case hex digits */
+};
 /* Ends (id, attempt) with outcome succeeded | failed | cancelled | infrastructure; exit_code < 0
- * for none. *duration_ms gets claim-to-finish time. */
+ * for none. *duration_ms gets claim-to-finish time. "succeeded" needs result.h5 among the declared
+ * artifacts and every one indexed for (id, attempt) with its size and SHA-256: else
+ * API_ARTIFACT_MISSING naming the first that is not, and nothing changes. */
 enum api_code store_finish(struct store *s, const struct principal *who, long long id, int attempt,
 			   const char *worker, const char *outcome, const char *message, int exit_code,
-			   const char *solver_version, json_t **job, long long *duration_ms, struct api_error *err);
+			   const char *solver_version, const struct finish_artifact *artifacts, int artifact_count,
+			   json_t **job, long long *duration_ms, struct api_error *err);
 
 /* Reaper (once a second): expired leases back to queued (or failed / cancelled), wall-time
  * overruns failed. Counts what it did. */

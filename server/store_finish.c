@@ -6,6 +6,13 @@
  * the job; "infrastructure" is retried with backoff while attempts are left (requeue_or_fail). An
  * expired lease is an infrastructure failure too, except when a cancel was requested: then the job
  * is cancelled, never re-queued. A running job past wall_time_seconds plus one lease period fails.
+ *
+ * A success must be backed by its files: the worker declares what it uploaded for the attempt
+ * (name, size, SHA-256), and "succeeded" is accepted only when result.h5 is among them and every
+ * declared file is in the index of this very attempt with the same size and digest
+ * (check_artifacts, in the same transaction as the transition, so no upload can slip between the
+ * check and the state change). Otherwise the finish is 409 artifact_missing and the attempt stays
+ * running: the worker still holds its files and can report what happened.
  */
 #include "store_internal.h"
 
@@ -18,15 +25,62 @@ struct finish_op {
 	long long id;
 	int attempt, exit_code;
 	const char *worker, *outcome, *message, *solver_version;
+	const struct finish_artifact *artifacts;
+	int artifact_count;
 	json_t *job;
 	long long duration;
 };
+
+#define RESULT_NAME "result.h5"
+
+/* The declared artifacts of a success against the file index of (id, attempt): API_OK, or
+ * API_ARTIFACT_MISSING naming the first that is missing or differs. */
+static enum api_code check_artifacts(struct conn *c, const struct finish_op *op, struct api_error *err)
+{
+	int has_result = 0;
+	for (int i = 0; i < op->artifact_count; i++)
+		has_result |= strcmp(op->artifacts[i].name, RESULT_NAME) == 0;
+	if (!has_result)
+		return api_fail(err, API_ARTIFACT_MISSING, "/artifacts",
+				"attempt %d of job %lld cannot succeed without '%s': it is not among the %d declared "
+				"artifacts", op->attempt, op->id, RESULT_NAME, op->artifact_count);
+	sqlite3_stmt *st = conn_stmt(c, "SELECT size, sha256 FROM files WHERE job_id = ?1 AND attempt = ?2 AND name = ?3");
+	if (!st)
+		return db_fail(c, err, "preparing an artifact check");
+	enum api_code rc = API_OK;
+	for (int i = 0; i < op->artifact_count && rc == API_OK; i++) {
+		const struct finish_artifact *a = &op->artifacts[i];
+		char field[32];
+		snprintf(field, sizeof field, "/artifacts/%d", i);
+		sqlite3_reset(st);
+		sqlite3_bind_int64(st, 1, op->id);
+		sqlite3_bind_int(st, 2, op->attempt);
+		sqlite3_bind_text(st, 3, a->name, -1, SQLITE_STATIC);
+		int step = sqlite3_step(st);
+		if (step != SQLITE_ROW && step != SQLITE_DONE)
+			rc = db_fail(c, err, "checking an artifact");
+		else if (step == SQLITE_DONE)
+			rc = api_fail(err, API_ARTIFACT_MISSING, field, "artifact '%s' (%lld bytes) of attempt %d was never "
+				      "stored", a->name, a->size, op->attempt);
+		else if (sqlite3_column_int64(st, 0) != a->size)
+			rc = api_fail(err, API_ARTIFACT_MISSING, field, "artifact '%s' of attempt %d is stored with %lld "
+				      "bytes, the finish declares %lld", a->name, op->attempt,
+				      (long long)sqlite3_column_int64(st, 0), a->size);
+		else if (strcmp(col_text(st, 1), a->sha256) != 0)
+			rc = api_fail(err, API_ARTIFACT_MISSING, field, "artifact '%s' of attempt %d is stored with SHA-256 "
+				      "%s, the finish declares %s", a->name, op->attempt, col_text(st, 1), a->sha256);
+	}
+	sqlite3_reset(st);
+	return rc;
+}
 
 static enum api_code finish_run(struct store *s, struct conn *c, void *arg, struct api_error *err)
 {
 	struct finish_op *op = arg;
 	long long started = 0;
 	enum api_code rc = lease_live(c, op->who, op->id, op->attempt, NULL, &started, err);
+	if (rc == API_OK && strcmp(op->outcome, "succeeded") == 0)
+		rc = check_artifacts(c, op, err);
 	if (rc != API_OK)
 		return rc;
 	op->duration = now_ms() - started;
@@ -64,10 +118,12 @@ static enum api_code finish_run(struct store *s, struct conn *c, void *arg, stru
 
 enum api_code store_finish(struct store *s, const struct principal *who, long long id, int attempt,
 			   const char *worker, const char *outcome, const char *message, int exit_code,
-			   const char *solver_version, json_t **job, long long *duration_ms, struct api_error *err)
+			   const char *solver_version, const struct finish_artifact *artifacts, int artifact_count,
+			   json_t **job, long long *duration_ms, struct api_error *err)
 {
 	struct finish_op op = { .who = who, .id = id, .attempt = attempt, .exit_code = exit_code, .worker = worker,
-				.outcome = outcome, .message = message, .solver_version = solver_version };
+				.outcome = outcome, .message = message, .solver_version = solver_version,
+				.artifacts = artifacts, .artifact_count = artifact_count };
 	enum api_code rc = store_write(s, finish_run, &op, err);
 	if (rc != API_OK) {
 		json_decref(op.job);

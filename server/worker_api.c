@@ -2,6 +2,9 @@
  * worker_api.c - the workers' JSON routes (docs/service.md §3 "Workers"): claim by long-poll,
  * heartbeat, log chunks, finish. File transfers are in files.c.
  *
+ * A finish may declare "artifacts": [{"name", "size", "sha256"}], the files the worker uploaded for
+ * the attempt; "succeeded" needs them (store_finish checks them against the file index).
+ *
  * Long-poll: a claim that finds nothing waits on srv->claim_cv, which the writer broadcasts after
  * committing a submission or a re-queue, and retries; it also retries once a second, because a
  * job whose backoff (not_before) passes wakes nobody. The claim sequence number read before each
@@ -10,6 +13,8 @@
 #include "api.h"
 #include "metrics.h"
 #include "store.h"
+
+#include "digest.h"
 
 #include <errno.h>
 #include <string.h>
@@ -21,6 +26,7 @@
 #define ATTEMPT_MAX 1000000
 #define OFFSET_MAX (1LL << 50)
 #define EXIT_CODE_MAX 255
+#define ARTIFACTS_MAX 16   /* files one finish may declare; a worker uploads four */
 
 /* Required integer member: 0, or -1 after replying. */
 static int required_int(struct request *r, json_t *body, const char *key, long long min, long long max,
@@ -154,20 +160,74 @@ done:
 	json_decref(body);
 }
 
+/* One declared artifact {"name", "size", "sha256"} at /artifacts/i: 0, or -1 after replying 422. */
+static int parse_artifact(struct request *r, json_t *item, size_t i, struct finish_artifact *a, char *sha)
+{
+	char field[SERVER_FIELD_MAX];
+	snprintf(field, sizeof field, "/artifacts/%zu", i);
+	json_t *name = json_object_get(item, "name"), *size = json_object_get(item, "size");
+	json_t *digest = json_object_get(item, "sha256");
+	const char *hex = json_string_value(digest);
+	int ok = json_is_object(item) && json_object_size(item) == 3 && json_is_string(name) &&
+		 api_file_name_valid(json_string_value(name)) && json_is_integer(size) && json_integer_value(size) >= 0 &&
+		 hex && strlen(hex) == DIGEST_HEX_SIZE - 1;
+	for (int k = 0; ok && k < DIGEST_HEX_SIZE - 1; k++) {
+		char c = hex[k];
+		ok = (c >= '0' && c <= '9') || (c >= 'a' && c <= 'f') || (c >= 'A' && c <= 'F');
+		sha[k] = (char)(c >= 'A' && c <= 'F' ? c - 'A' + 'a' : c);
+	}
+	if (!ok) {
+		reply_fail(r, API_INVALID_REQUEST, field,
+			   "artifact %zu must be {\"name\": a file name, \"size\": bytes >= 0, \"sha256\": 64 hex digits} "
+			   "and nothing else", i);
+		return -1;
+	}
+	sha[DIGEST_HEX_SIZE - 1] = '\0';
+	*a = (struct finish_artifact){ json_string_value(name), (long long)json_integer_value(size), sha };
+	return 0;
+}
+
+/* The optional "artifacts" list of a finish: 0 with *count entries, or -1 after replying 422. */
+static int parse_artifacts(struct request *r, json_t *body, struct finish_artifact *out,
+			   char sha[][DIGEST_HEX_SIZE], int *count)
+{
+	json_t *list = json_object_get(body, "artifacts"), *item;
+	*count = 0;
+	if (!list || json_is_null(list))
+		return 0;
+	if (!json_is_array(list) || json_array_size(list) > ARTIFACTS_MAX) {
+		reply_fail(r, API_INVALID_REQUEST, "/artifacts", "'artifacts' must be an array of at most %d files",
+			   ARTIFACTS_MAX);
+		return -1;
+	}
+	size_t i;
+	json_array_foreach(list, i, item) {
+		if (parse_artifact(r, item, i, &out[i], sha[i]))
+			return -1;
+	}
+	*count = (int)json_array_size(list);
+	return 0;
+}
+
 void worker_finish(struct request *r)
 {
-	static const char *const keys[] = { "attempt", "outcome", "message", "exit_code", "solver_version", NULL };
+	static const char *const keys[] = { "attempt", "outcome", "message", "exit_code", "solver_version",
+					    "artifacts", NULL };
 	static const char *const outcomes[] = { "succeeded", "failed", "cancelled", "infrastructure", NULL };
 	json_t *body = api_body_object(r);
 	if (!body)
 		return;
 	long long attempt, exit_code;
 	const char *outcome, *message, *version;
+	struct finish_artifact artifacts[ARTIFACTS_MAX];
+	char sha[ARTIFACTS_MAX][DIGEST_HEX_SIZE];
+	int artifact_count = 0;
 	if (api_known_keys(r, body, keys) || required_int(r, body, "attempt", 1, ATTEMPT_MAX, &attempt) ||
 	    api_string_member(r, body, "outcome", 32, 1, &outcome) ||
 	    api_string_member(r, body, "message", MESSAGE_MAX, 0, &message) ||
 	    api_int_member(r, body, "exit_code", -EXIT_CODE_MAX, EXIT_CODE_MAX, -1, &exit_code) ||
-	    api_string_member(r, body, "solver_version", SERVER_NAME_MAX, 0, &version))
+	    api_string_member(r, body, "solver_version", SERVER_NAME_MAX, 0, &version) ||
+	    parse_artifacts(r, body, artifacts, sha, &artifact_count))
 		goto done;
 	int known = 0;
 	for (const char *const *o = outcomes; *o && !known; o++)
@@ -181,7 +241,7 @@ void worker_finish(struct request *r)
 	long long duration = 0;
 	struct api_error err = { 0 };
 	if (store_finish(r->srv->store, &r->who, r->id, (int)attempt, r->who.name, outcome, message, (int)exit_code,
-			 version, &job, &duration, &err) != API_OK) {
+			 version, artifacts, artifact_count, &job, &duration, &err) != API_OK) {
 		reply_error(r, &err);
 		goto done;
 	}

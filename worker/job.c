@@ -8,6 +8,14 @@
  *   error message; exit 6 or a signal after a cancel -> cancelled; wall time exceeded -> failed;
  *   exit 4 or 5, a signal the worker did not send, a failure to start, a second SIGTERM to the
  *   worker -> infrastructure (the server re-queues the job and it resumes from its checkpoint).
+ *
+ * A success needs its files on the server (settle): the finish declares every file the final
+ * uploads stored ("artifacts", which the server checks against its index), and a file that did not
+ * get there turns "succeeded" into "failed" when the server refused it (413, 422: a retry would end
+ * the same way) or "infrastructure" when it kept failing until WORKER_FINISH_PATIENCE ran out; the
+ * job directory is then kept, whatever --keep-work says, and the message says where. Each staged
+ * result.h5 gets its probes.json from a `poro-solve probes` child (probes.h), uploaded right after
+ * it; a failed extraction costs only the probes.
  */
 #define _GNU_SOURCE
 #include "job.h"
@@ -26,12 +34,20 @@
 #include "job_files.h"
 #include "json_get.h"
 #include "log_pump.h"
+#include "probes.h"
 #include "worker.h"
 
 /* Supervision period, seconds. */
 #define JOB_TICK 0.05
 /* Attempts at downloading a checkpoint before the job is handed back as infrastructure. */
 #define JOB_FETCH_TRIES 5
+/* Seconds the finish call still gets when the final uploads used up WORKER_FINISH_PATIENCE: an
+ * attempt whose files could not be sent is reported, not left to expire. */
+#define JOB_REPORT_PATIENCE 60.0
+/* Files a finish declares: result.h5, probes.json, result.xdmf, checkpoint.h5. */
+#define JOB_ARTIFACTS_MAX 4
+#define JOB_PROBES_NAME "probes.json"
+#define JOB_TEXT_MAX 8192   /* bytes of a message about the files, as the server's MESSAGE_MAX */
 
 enum stop_reason { STOP_NONE, STOP_CANCEL, STOP_WALL, STOP_SHUTDOWN, STOP_LOST };
 enum send_result { SEND_OK, SEND_RETRY, SEND_REFUSED, SEND_LOST };
@@ -40,6 +56,14 @@ enum send_result { SEND_OK, SEND_RETRY, SEND_REFUSED, SEND_LOST };
 struct staged {
 	int pending;
 	char path[4400];
+	char sha256[DIGEST_HEX_SIZE];
+	long long size;          /* bytes */
+};
+
+/* A file the final uploads stored, as the finish declares it. */
+struct artifact {
+	char name[32];
+	long long size;
 	char sha256[DIGEST_HEX_SIZE];
 };
 
@@ -67,7 +91,18 @@ struct job {
 	struct backoff log_b, hb_b, up_b;
 	double next_heartbeat_at;
 	int checkpoints_seen;
-	struct staged up_result, up_checkpoint; /* result.h5 goes first, so it is never older */
+	/* result.h5 goes first, so it is never older; its probes.json follows once extracted */
+	struct staged up_result, up_checkpoint, up_probes;
+	struct probes_run probes;
+	char upload_why[700];    /* the answer (or transport error) of the last failed upload */
+
+	struct artifact declared[JOB_ARTIFACTS_MAX]; /* what the final uploads stored */
+	int declared_count;
+	char problem[JOB_TEXT_MAX]; /* the first final upload that did not reach the server, and why */
+	int problem_permanent;   /* ... because the server refused it: a retry would end the same way */
+	char result_missing[300]; /* why out/result.h5 could not be staged, "" when it was */
+	char probes_note[JOB_TEXT_MAX]; /* why the final result has no probes.json, "" when it has */
+	int keep;                /* keep the directory: a file of the attempt is not on the server */
 };
 
 static void say_job(const struct job *j, const char *what, const struct http_response *r)
@@ -85,7 +120,8 @@ static enum send_result classify(struct job *j, const char *what, const struct h
 		backoff_reset(b);
 		return SEND_OK;
 	}
-	if (r->status == 404 || (r->status == 409 && strcmp(r->code, "log_gap"))) {
+	/* artifact_missing is a finish the server could not accept; log_gap is sorted out by send_log */
+	if (r->status == 404 || (r->status == 409 && strcmp(r->code, "log_gap") && strcmp(r->code, "artifact_missing"))) {
 		worker_say("%s: %s refused, the lease is gone: %s", j->tag, what, http_describe(r, why, sizeof why));
 		j->stop = STOP_LOST;
 		return SEND_LOST;
@@ -175,6 +211,8 @@ static enum send_result upload(struct job *j, const char *name, struct staged *f
 	snprintf(what, sizeof what, "upload of '%s'", name);
 	job_files_upload(j->http, j->id, j->attempt, name, f->path, f->sha256, &r);
 	enum send_result s = classify(j, what, &r, &j->up_b);
+	if (s != SEND_OK)
+		http_describe(&r, j->upload_why, sizeof j->upload_why);
 	if (s == SEND_OK || s == SEND_REFUSED)
 		f->pending = 0;
 	http_response_release(&r);
@@ -188,11 +226,11 @@ static int stage(struct job *j, const char *name, struct staged *f, int snapshot
 	snprintf(src, sizeof src, "%s/out/%s", j->dir, name);
 	if (!snapshot) {
 		snprintf(f->path, sizeof f->path, "%s", src);
-		if (digest_file_hex(src, f->sha256, NULL) < 0)
+		if (digest_file_hex(src, f->sha256, &f->size) < 0)
 			return -1;
 	} else {
 		snprintf(f->path, sizeof f->path, "%s/upload/%s", j->dir, name);
-		if (job_files_snapshot(src, f->path, f->sha256) < 0) {
+		if (job_files_snapshot(src, f->path, f->sha256, &f->size) < 0) {
 			if (errno != ENOENT)
 				worker_say("%s: cannot copy '%s' for upload: %s", j->tag, name, strerror(errno));
 			return -1;
@@ -202,20 +240,61 @@ static int stage(struct job *j, const char *name, struct staged *f, int snapshot
 	return 0;
 }
 
-/* After a "checkpoint" line: snapshot checkpoint.h5 and result.h5, then upload them in turn. */
+/* Starts extracting the probes of result (relative to the job directory); a failure to start is
+ * said, and kept in note when note is not NULL. */
+static void start_probes(struct job *j, const char *result, char *note, size_t note_size)
+{
+	char err[700];
+	j->up_probes.pending = 0;
+	if (probes_start(&j->probes, j->dir, result, j->id, j->attempt, err, sizeof err) == 0)
+		return;
+	worker_say("%s: no probes.json for '%s': cannot start poro-solve probes: %s", j->tag, result, err);
+	if (note)
+		snprintf(note, note_size, "no probes.json: cannot start poro-solve probes: %s", err);
+}
+
+/* Polls the extraction: PROBES_DONE with probes.json staged in f; PROBES_FAILED said, and kept in
+ * note when note is not NULL; PROBES_RUNNING or PROBES_NONE. */
+static enum probes_state collect_probes(struct job *j, struct staged *f, double now, char *note, size_t note_size)
+{
+	char why[5000];
+	enum probes_state st = probes_poll(&j->probes, now, why, sizeof why);
+	if (st == PROBES_DONE) {
+		snprintf(f->path, sizeof f->path, "%s/%s", j->dir, PROBES_OUT);
+		if (digest_file_hex(f->path, f->sha256, &f->size) == 0) {
+			f->pending = 1;
+		} else {
+			snprintf(why, sizeof why, "cannot read '%s': %s", f->path, strerror(errno));
+			st = PROBES_FAILED;
+		}
+	}
+	if (st == PROBES_FAILED) {
+		worker_say("%s: no probes.json for this result.h5: %s", j->tag, why);
+		if (note)
+			snprintf(note, note_size, "no probes.json: %s", why);
+	}
+	return st;
+}
+
+/* After a "checkpoint" line: snapshot checkpoint.h5 and result.h5, extract the probes of the
+ * snapshot, then upload result.h5, probes.json (once extracted) and checkpoint.h5 in turn. */
 static void checkpoint_uploads(struct job *j, double now)
 {
 	int seen = log_pump_checkpoints(&j->pump);
 	if (seen > j->checkpoints_seen) {
 		j->checkpoints_seen = seen;
 		if (stage(j, "checkpoint.h5", &j->up_checkpoint, 1) == 0) {
-			stage(j, "result.h5", &j->up_result, 1);
+			if (stage(j, "result.h5", &j->up_result, 1) == 0)
+				start_probes(j, "upload/result.h5", NULL, 0);
 			backoff_reset(&j->up_b);
 		}
 	}
+	collect_probes(j, &j->up_probes, now, NULL, 0);
 	if (!backoff_due(&j->up_b, now))
 		return;
 	if (j->up_result.pending && upload(j, "result.h5", &j->up_result) != SEND_OK)
+		return;
+	if (j->up_probes.pending && upload(j, JOB_PROBES_NAME, &j->up_probes) != SEND_OK)
 		return;
 	if (j->up_checkpoint.pending && upload(j, "checkpoint.h5", &j->up_checkpoint) == SEND_OK)
 		worker_say("%s: checkpoint uploaded", j->tag);
@@ -355,43 +434,206 @@ static void flush_log(struct job *j, double deadline)
 		send_log(j);
 }
 
-static void final_uploads(struct job *j, double deadline)
+/* "5.2 GB", "857.7 kB", "312 bytes": a size for messages, in SI units. */
+static void format_size(long long bytes, char *out, size_t size)
 {
-	static const char *names[] = {"result.h5", "result.xdmf", "checkpoint.h5"};
-	/* a checkpoint announced but not yet sent goes first, as during the run */
-	while ((j->up_result.pending || j->up_checkpoint.pending) && wait_retry(j, &j->up_b, deadline))
-		checkpoint_uploads(j, worker_now());
-	for (size_t i = 0; i < sizeof names / sizeof *names; i++) {
-		struct staged f = {0};
-		if (stage(j, names[i], &f, 0) < 0)
-			continue;
-		while (f.pending && wait_retry(j, &j->up_b, deadline))
-			upload(j, names[i], &f);
+	static const char *const units[] = { "kB", "MB", "GB", "TB" };
+	double v = (double)bytes;
+	int u = -1;
+	while (v >= 1000 && u < 3) {
+		v /= 1000;
+		u++;
+	}
+	if (u < 0)
+		snprintf(out, size, "%lld bytes", bytes);
+	else
+		snprintf(out, size, "%.1f %s", v, units[u]);
+}
+
+/* One file of the final uploads, retried while the failures are transient. A stored file is
+ * declared in the finish; the first other file that did not get there is the attempt's problem
+ * (probes.json only loses the probes: it is derived, not a result). */
+static void upload_final(struct job *j, const char *name, struct staged *f, double deadline)
+{
+	enum send_result s = SEND_RETRY;
+	j->upload_why[0] = '\0';
+	while (f->pending && wait_retry(j, &j->up_b, deadline))
+		s = upload(j, name, f);
+	if (j->stop == STOP_LOST)
+		return;
+	if (s == SEND_OK) {
+		struct artifact *a = &j->declared[j->declared_count++];
+		snprintf(a->name, sizeof a->name, "%s", name);
+		a->size = f->size;
+		memcpy(a->sha256, f->sha256, DIGEST_HEX_SIZE);
+		return;
+	}
+	char bytes[32], text[JOB_TEXT_MAX - 64];
+	format_size(f->size, bytes, sizeof bytes);
+	if (s == SEND_REFUSED)
+		snprintf(text, sizeof text, "%s (%s) was refused by the server: %s", name, bytes, j->upload_why);
+	else
+		snprintf(text, sizeof text, "%s (%s) did not reach the server within the worker's %.0f s of retries: %s",
+			 name, bytes, WORKER_FINISH_PATIENCE, j->upload_why[0] ? j->upload_why : "no time was left to send it");
+	worker_say("%s: %s", j->tag, text);
+	if (!strcmp(name, JOB_PROBES_NAME)) {
+		snprintf(j->probes_note, sizeof j->probes_note, "no probes.json: %s", text);
+		return;
+	}
+	j->keep = 1;
+	if (!j->problem[0]) {
+		snprintf(j->problem, sizeof j->problem, "%s", text);
+		j->problem_permanent = s == SEND_REFUSED;
 	}
 }
 
-static void finish(struct job *j, const char *result, const char *message, int exit_code, double deadline)
+/* Waits, heartbeats going, for the probes of the final result; 0 with probes.json staged in f. */
+static int final_probes(struct job *j, struct staged *f, double deadline)
 {
+	enum probes_state st;
+	while ((st = collect_probes(j, f, worker_now(), j->probes_note, sizeof j->probes_note)) == PROBES_RUNNING) {
+		if (!before_deadline(deadline) || j->stop == STOP_LOST) {
+			probes_stop(&j->probes);
+			snprintf(j->probes_note, sizeof j->probes_note, "no probes.json: no time was left to extract them");
+			return -1;
+		}
+		heartbeat_if_due(j, worker_now());
+		usleep(20000);
+	}
+	return st == PROBES_DONE ? 0 : -1;
+}
+
+static void final_uploads(struct job *j, double deadline)
+{
+	/* declared[] has room for each of them */
+	static const char *const names[JOB_ARTIFACTS_MAX] = {"result.h5", JOB_PROBES_NAME, "result.xdmf",
+							     "checkpoint.h5"};
+	/* a checkpoint announced but not yet sent goes first, as during the run */
+	while ((j->up_result.pending || j->up_checkpoint.pending) && wait_retry(j, &j->up_b, deadline))
+		checkpoint_uploads(j, worker_now());
+	probes_stop(&j->probes);   /* the final result supersedes a snapshot's extraction */
+	j->up_probes.pending = 0;
+	for (size_t i = 0; i < sizeof names / sizeof *names && j->stop != STOP_LOST; i++) {
+		struct staged f = {0};
+		if (!strcmp(names[i], JOB_PROBES_NAME)) {
+			if (final_probes(j, &f, deadline) < 0)
+				continue;
+		} else if (stage(j, names[i], &f, 0) < 0) {
+			if (i == 0)
+				snprintf(j->result_missing, sizeof j->result_missing, "%s", strerror(errno));
+			continue;
+		}
+		if (i == 0)   /* extracted while result.h5 is sent */
+			start_probes(j, "out/result.h5", j->probes_note, sizeof j->probes_note);
+		upload_final(j, names[i], &f, deadline);
+	}
+}
+
+static int is_declared(const struct job *j, const char *name)
+{
+	for (int i = 0; i < j->declared_count; i++)
+		if (!strcmp(j->declared[i].name, name))
+			return 1;
+	return 0;
+}
+
+/* Appends "; text" to message (or sets it when empty), cut to size. */
+static void append(char *message, size_t size, const char *text)
+{
+	size_t n = strlen(message), sep = n ? 2 : 0;
+	if (n + sep + 1 >= size)
+		return;
+	memcpy(message + n, "; ", sep);
+	n += sep;
+	size_t take = strlen(text);
+	if (take > size - 1 - n)
+		take = size - 1 - n;
+	memcpy(message + n, text, take);
+	message[n + take] = '\0';
+}
+
+/* The outcome once the final uploads are known (see the top of this file); says when the
+ * directory is kept. */
+static const char *settle(struct job *j, const char *result, char *message, size_t size)
+{
+	int succeeded = !strcmp(result, "succeeded");
+	if (succeeded && !j->problem[0] && !is_declared(j, "result.h5") && j->result_missing[0]) {
+		snprintf(j->problem, sizeof j->problem, "the solver exited 0 but result.h5 cannot be read in '%s/out': %s",
+			 j->dir, j->result_missing);
+		j->problem_permanent = 1;
+		j->keep = 1;
+	}
+	if (j->problem[0] && succeeded) {
+		result = j->problem_permanent ? "failed" : "infrastructure";
+		snprintf(message, size, "%s", j->problem);
+	} else if (j->problem[0]) {
+		append(message, size, j->problem);
+	} else if (succeeded && j->probes_note[0]) {
+		snprintf(message, size, "%s", j->probes_note);
+	}
+	if (j->keep) {
+		char kept[4700];
+		snprintf(kept, sizeof kept, "the files are kept in %s on host %s", j->dir, worker_opt.host);
+		append(message, size, kept);
+		worker_say("%s: keeping %s: not every file of the attempt reached the server", j->tag, j->dir);
+	}
+	return result;
+}
+
+/* The finish body, with the declared artifacts. */
+static json_t *finish_body(const struct job *j, const char *result, const char *message, int exit_code)
+{
+	json_t *artifacts = json_array();
+	for (int i = 0; i < j->declared_count; i++)
+		json_array_append_new(artifacts, json_pack("{s:s, s:I, s:s}", "name", j->declared[i].name, "size",
+							   (json_int_t)j->declared[i].size, "sha256", j->declared[i].sha256));
 	/* an empty message is sent as null: the server takes strings of 1 byte or more */
-	json_t *body = json_pack("{s:i, s:s, s:o, s:i, s:s}", "attempt", j->attempt, "outcome", result, "message",
-				 message[0] ? json_string(message) : json_null(), "exit_code", exit_code, "solver_version",
-				 worker_opt.solver_version);
+	return json_pack("{s:i, s:s, s:o, s:i, s:s, s:o}", "attempt", j->attempt, "outcome", result, "message",
+			 message[0] ? json_string(message) : json_null(), "exit_code", exit_code, "solver_version",
+			 worker_opt.solver_version, "artifacts", artifacts);
+}
+
+/* Sends the finish until it is answered; SEND_REFUSED leaves the server's code and message in
+ * code and why. */
+static enum send_result finish(struct job *j, const char *result, const char *message, int exit_code,
+			       double deadline, char code[64], char *why, size_t why_size)
+{
+	json_t *body = finish_body(j, result, message, exit_code);
 	char path[128];
 	snprintf(path, sizeof path, "/v1/worker/jobs/%lld/finish", j->id);
 	struct backoff b = {0};
-	int done = 0;
-	while (!done && wait_retry(j, &b, deadline)) {
+	enum send_result s = SEND_RETRY;
+	while (s == SEND_RETRY && wait_retry(j, &b, deadline)) {
 		struct http_response r;
 		http_json(j->http, "POST", path, body, NULL, 30, &r);
-		enum send_result s = classify(j, "finish", &r, &b);
-		http_response_release(&r);
+		s = classify(j, "finish", &r, &b);
 		if (s == SEND_OK)
 			worker_say("%s: finished %s%s%s", j->tag, result, message[0] ? ": " : "", message);
-		done = s != SEND_RETRY;
+		snprintf(code, 64, "%s", r.code);
+		http_describe(&r, why, why_size);
+		http_response_release(&r);
 	}
-	if (!done && j->stop != STOP_LOST)
+	if (s == SEND_RETRY && j->stop != STOP_LOST)
 		worker_say("%s: gave up reporting '%s'; the lease will expire", j->tag, result);
 	json_decref(body);
+	return s;
+}
+
+/* Reports the outcome. A success the server cannot match with its files (artifact_missing) is
+ * reported again as an infrastructure failure, the directory kept: the job is retried. */
+static void report(struct job *j, const char *result, char *message, size_t size, int exit_code, double deadline)
+{
+	char code[64] = "", why[800] = "";
+	if (worker_now() + JOB_REPORT_PATIENCE > deadline)
+		deadline = worker_now() + JOB_REPORT_PATIENCE;
+	if (finish(j, result, message, exit_code, deadline, code, why, sizeof why) != SEND_REFUSED ||
+	    strcmp(code, "artifact_missing"))
+		return;
+	snprintf(message, size, "the server does not hold the files the worker uploaded: %s; the files are kept in %s "
+		 "on host %s", why, j->dir, worker_opt.host);
+	j->keep = 1;
+	worker_say("%s: keeping %s: the server does not hold the declared files", j->tag, j->dir);
+	finish(j, "infrastructure", message, exit_code, deadline, code, why, sizeof why);
 }
 
 /* Fills j from the claim and creates the job directory with case.json. 0, or -1 with err. */
@@ -497,6 +739,7 @@ void job_run(struct http_client *c, const json_t *claim)
 	struct job j = {0};
 	char err[10000];
 	j.http = c;
+	probes_init(&j.probes);
 	j.chunk = malloc(WORKER_LOG_CHUNK);
 	int prepared = prepare(&j, claim, err, sizeof err) == 0 && j.chunk;
 	const json_t *checkpoint = json_object_get(claim, "checkpoint");
@@ -512,7 +755,7 @@ void job_run(struct http_client *c, const json_t *claim)
 	if (!started) {
 		worker_say("%s: cannot run: %s", j.tag, err);
 		if (j.id >= 0)
-			finish(&j, "infrastructure", err, -1, worker_now() + WORKER_FINISH_PATIENCE);
+			report(&j, "infrastructure", err, sizeof err, -1, worker_now() + WORKER_FINISH_PATIENCE);
 	} else {
 		supervise(&j);
 		if (j.stop == STOP_LOST) {
@@ -527,12 +770,17 @@ void job_run(struct http_client *c, const json_t *claim)
 			flush_log(&j, deadline);
 			if (strcmp(result, "infrastructure") || !atomic_load(&worker_stopping))
 				final_uploads(&j, deadline);
-			if (j.stop != STOP_LOST)
-				finish(&j, result, message, exit_code, deadline);
+			if (j.stop != STOP_LOST) {
+				result = settle(&j, result, message, sizeof message);
+				report(&j, result, message, sizeof message, exit_code, deadline);
+			}
 		}
+		probes_stop(&j.probes);
 		log_pump_release(&j.pump);
 	}
 	free(j.chunk);
-	if (!worker_opt.keep_work)   /* kept for inspection: what the solver wrote, byte for byte */
+	/* kept for inspection with --keep-work (what the solver wrote, byte for byte), and whenever a
+	 * file of the attempt is not on the server: then it is the only copy */
+	if (!worker_opt.keep_work && !j.keep)
 		job_files_remove_tree(j.dir);
 }

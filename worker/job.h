@@ -4,7 +4,8 @@
  * with progress, checkpoint uploads, cancel and wall-time enforcement, the final uploads and the
  * finish call (docs/service.md §2, §3 "Workers"). A write refused as stale (409) or for a job
  * that is gone (404) means the lease is lost: the solver's group is killed at once, the directory
- * removed, and nothing more is sent.
+ * removed, and nothing more is sent. A file of the attempt that did not reach the server keeps the
+ * directory (§3 "Success needs its files").
  */
 #ifndef PORO_JOB_H
 #define PORO_JOB_H
@@ -14,7 +15,8 @@
 #include "http_client.h"
 
 /* Runs the job of a claim answer ({"id", "attempt", "case", ...}) to its end with c, which must not
- * abort on drain. Returns when the job is finished or abandoned and its directory is removed. */
+ * abort on drain. Returns when the job is finished or abandoned and its directory is removed (or
+ * kept: --keep-work, or files the server does not hold). */
 void job_run(struct http_client *c, const json_t *claim);
 
 #endif

@@ -51,8 +51,9 @@ int job_files_fetch_resume(struct http_client *c, long long id, int attempt, con
 	return rc == 2 ? 0 : rc;
 }
 
-int job_files_snapshot(const char *src, const char *dst, char sha256[DIGEST_HEX_SIZE])
+int job_files_snapshot(const char *src, const char *dst, char sha256[DIGEST_HEX_SIZE], long long *size)
 {
+	*size = 0;
 	FILE *in = fopen(src, "rb");
 	if (!in)
 		return -1;
@@ -72,6 +73,7 @@ int job_files_snapshot(const char *src, const char *dst, char sha256[DIGEST_HEX_
 	int failed = 0;
 	while ((got = fread(buf, 1, sizeof buf, in)) > 0) {
 		digest_update(d, buf, got);
+		*size += (long long)got;
 		if (fwrite(buf, 1, got, out) != got) {
 			failed = 1;
 			break;

@@ -4,8 +4,8 @@
  * runs each as a poro-solve child process and sends log, progress, files and the outcome back
  * (docs/service.md §2, §3 "Workers", §5). The files: main.c (flags, signals, slot threads),
  * slot.c (the claim loop of one slot), job.c (one running job), child.c (the solver process),
- * log_pump.c (the solver's output), job_files.c (checkpoint download and uploads), backoff.c
- * (retry delays). The worker keeps no state that matters: losing it loses at most the work since
+ * log_pump.c (the solver's output), job_files.c (checkpoint download and uploads), probes.c (the
+ * probes.json of each uploaded result, by a `poro-solve probes` child), backoff.c (retry delays). The worker keeps no state that matters: losing it loses at most the work since
  * the job's last uploaded checkpoint.
  */
 #ifndef PORO_WORKER_H

@@ -304,14 +304,15 @@ code=$(svc_req GET "/v1/worker/jobs/$cid/files/result.h5" "$worker")
 [ "$code" = 200 ] && cmp -s "$SVC_BODY" "$tmp/result.h5" && [ "$(svc_header X-Checksum-Sha256)" = "$fsha" ]
 check worker_download_200 $? "status $code"
 
+# the server never reads result.h5: probes come from the probes.json a worker uploads
 code=$(svc_req GET "/v1/jobs/$cid/probes" "$alice")
-expect_error probes_of_unreadable_result_500 500 internal "" "$code"
-grep -q "cannot read the result of job $cid" "$SVC_BODY"
+expect_error probes_without_probes_json_404 404 not_found "" "$code"
+grep -q "job $cid has no probes yet" "$SVC_BODY"
 check probes_error_names_the_job $? "$(head -c 300 "$SVC_BODY")"
 
 sleep 0.3
 logpost 1 14 'step 3\n' > /dev/null
-code=$(svc_req POST "/v1/worker/jobs/$cid/finish" "$worker" -d '{"attempt": 1, "outcome": "succeeded", "message": "done", "exit_code": 0, "solver_version": "v1.2-test"}')
+code=$(svc_req POST "/v1/worker/jobs/$cid/finish" "$worker" -d '{"attempt": 1, "outcome": "succeeded", "message": "done", "exit_code": 0, "solver_version": "v1.2-test", "artifacts": [{"name": "result.h5", "size": 70001, "sha256": "'"$fsha"'"}]}')
 [ "$code" = 200 ] && [ "$(json '["state"]' < "$SVC_BODY")" = succeeded ] && [ "$(json '["finished_at"]' < "$SVC_BODY")" != null ]
 check finish_succeeded $? "status $code: $(head -c 300 "$SVC_BODY")"
 for i in $(seq 50); do kill -0 "$follower" 2>/dev/null || break; sleep 0.1; done
@@ -451,7 +452,7 @@ e1a=$(json '["job"]["attempt"]' < "$SVC_BODY")
 code=$(claim "$wp")
 [ -n "$e1" ] && [ "$code" = 204 ]
 check running_cap_holds_second_job $? "first claim got '$e1', second claim answered $code"
-svc_req POST "/v1/worker/jobs/$e1/finish" "$wp" -d "{\"attempt\": $e1a, \"outcome\": \"succeeded\", \"message\": null, \"exit_code\": 0}" > /dev/null
+svc_req POST "/v1/worker/jobs/$e1/finish" "$wp" -d "{\"attempt\": $e1a, \"outcome\": \"failed\", \"message\": null, \"exit_code\": 3}" > /dev/null
 code=$(claim "$wp")
 e2=$(json '["job"]["id"]' < "$SVC_BODY")
 [ "$code" = 200 ] && [ -n "$e2" ] && [ "$e2" != "$e1" ]
