@@ -36,6 +36,8 @@ struct server_config {
 	int max_backoff_seconds;      /* cap of the retry backoff min(2^(attempt-1), cap) */
 	int group_commit_max;         /* most write requests in one transaction */
 	char access_log[SERVER_STATE_MAX]; /* one line per answered request, or "" for none */
+	long long max_log_bytes;      /* log text kept per attempt: its first and last half, bytes */
+	long long user_max_stored_bytes; /* default per-user cap on stored bytes; 0 = unlimited */
 };
 
 /*      code                        HTTP  name on the wire */
@@ -52,6 +54,7 @@ struct server_config {
 	X(API_METHOD_NOT_ALLOWED,   405, "method_not_allowed")               \
 	X(API_IDEMPOTENCY_CONFLICT, 409, "idempotency_conflict")             \
 	X(API_NOT_CANCELLABLE,      409, "not_cancellable")                  \
+	X(API_NOT_DELETABLE,        409, "not_deletable")                    \
 	X(API_STALE_ATTEMPT,        409, "stale_attempt")                    \
 	X(API_LOG_GAP,              409, "log_gap")                          \
 	X(API_ALREADY_EXISTS,       409, "already_exists")                   \
