@@ -16,6 +16,10 @@
  *       claims jobs and finishes each at once as "failed" (a success would need a stored result.h5,
  *       docs/service.md §3); prints claims per second and claim
  *       latency percentiles. A client stops when the queue stays empty for one short long-poll.
+ *   poro-load get --server URL --token T --path PATH --count N --clients C
+ *       N GET PATH (e.g. "/v1/jobs?state=queued") from C threads, each with its own keep-alive
+ *       connection; prints "gets: N ok, E errors, X.X per second; latency p50 ..." (listing
+ *       latency for make bench).
  *
  * Failures are counted, never fatal: the tool keeps going when the server disappears. Latency
  * percentiles are over the requests that got an answer (nearest-rank).
@@ -39,12 +43,12 @@
 #define LOAD_CLAIM_WAIT 1
 
 struct load {
-	const char *server, *token, *case_file, *key_prefix, *record_path;
+	const char *server, *token, *case_file, *key_prefix, *record_path, *path;
 	int clients;
 	double retry_seconds;    /* resend a failed submission for this long (0: never) */
 	long pause_ms;           /* a client's wait between its submissions */
 	long count;
-	int claim_mode;
+	enum { LOAD_SUBMIT, LOAD_CLAIM, LOAD_GET } mode;
 	json_t *body;            /* submission body (submit) */
 	atomic_long next;        /* next submission index / claims started */
 	atomic_long ok, errors, empty;
@@ -167,6 +171,27 @@ static void *claim_client(void *arg)
 	return NULL;
 }
 
+static void *get_client(void *arg)
+{
+	struct load *l = arg;
+	struct http_client *c = http_client_create(l->server, l->token);
+	if (!c)
+		return NULL;
+	for (;;) {
+		long i = atomic_fetch_add(&l->next, 1);
+		if (i >= l->count)
+			break;
+		struct http_response r;
+		double t0 = now_s();
+		long status = http_json(c, "GET", l->path, NULL, NULL, 60, &r);
+		l->latency_ms[i] = status ? 1e3 * (now_s() - t0) : NAN;
+		atomic_fetch_add(status == 200 ? &l->ok : &l->errors, 1);
+		http_response_release(&r);
+	}
+	http_client_destroy(&c);
+	return NULL;
+}
+
 static int cmp_double(const void *a, const void *b)
 {
 	double x = *(const double *)a, y = *(const double *)b;
@@ -186,7 +211,8 @@ static int usage(void)
 {
 	fprintf(stderr, "usage: poro-load submit --server URL --token T --case FILE --clients C --count N\n"
 			"                        [--key-prefix P] [--record FILE] [--retry-seconds S] [--pause-ms MS]\n"
-			"       poro-load claim --server URL --token WORKER_TOKEN --count N --clients C\n");
+			"       poro-load claim --server URL --token WORKER_TOKEN --count N --clients C\n"
+			"       poro-load get --server URL --token T --path PATH --count N --clients C\n");
 	return 2;
 }
 
@@ -195,7 +221,9 @@ static int parse_args(struct load *l, int argc, char **argv)
 	if (argc < 2)
 		return -1;
 	if (!strcmp(argv[1], "claim"))
-		l->claim_mode = 1;
+		l->mode = LOAD_CLAIM;
+	else if (!strcmp(argv[1], "get"))
+		l->mode = LOAD_GET;
 	else if (strcmp(argv[1], "submit"))
 		return -1;
 	for (int i = 2; i + 1 < argc; i += 2) {
@@ -218,12 +246,16 @@ static int parse_args(struct load *l, int argc, char **argv)
 			l->retry_seconds = atof(v);
 		else if (!strcmp(a, "--pause-ms"))
 			l->pause_ms = atol(v);
+		else if (!strcmp(a, "--path"))
+			l->path = v;
 		else
 			return -1;
 	}
 	if ((argc - 2) % 2 || !l->server || !l->token || l->clients < 1 || l->count < 1)
 		return -1;
-	return l->claim_mode || l->case_file ? 0 : -1;
+	if (l->mode == LOAD_GET)
+		return l->path ? 0 : -1;
+	return l->mode == LOAD_CLAIM || l->case_file ? 0 : -1;
 }
 
 int main(int argc, char **argv)
@@ -232,7 +264,7 @@ int main(int argc, char **argv)
 	l.key_prefix = "load";
 	if (parse_args(&l, argc, argv) < 0)
 		return usage();
-	if (!l.claim_mode) {
+	if (l.mode == LOAD_SUBMIT) {
 		json_error_t jerr;
 		json_t *spec = json_load_file(l.case_file, 0, &jerr);
 		if (!spec) {
@@ -258,7 +290,8 @@ int main(int argc, char **argv)
 	double t0 = now_s();
 	int started = 0;
 	for (int i = 0; i < l.clients; i++)
-		if (!pthread_create(&threads[started], NULL, l.claim_mode ? claim_client : submit_client, &l))
+		if (!pthread_create(&threads[started], NULL,
+				    l.mode == LOAD_CLAIM ? claim_client : l.mode == LOAD_GET ? get_client : submit_client, &l))
 			started++;
 	for (int i = 0; i < started; i++)
 		pthread_join(threads[i], NULL);
@@ -269,9 +302,11 @@ int main(int argc, char **argv)
 			l.latency_ms[n++] = l.latency_ms[i];
 	qsort(l.latency_ms, n, sizeof *l.latency_ms, cmp_double);
 	long ok = atomic_load(&l.ok), errors = atomic_load(&l.errors);
-	if (l.claim_mode)
+	if (l.mode == LOAD_CLAIM)
 		printf("claims: %ld ok, %ld errors, %ld empty, %.1f per second; ", ok, errors, atomic_load(&l.empty),
 		       elapsed > 0 ? (double)ok / elapsed : 0.0);
+	else if (l.mode == LOAD_GET)
+		printf("gets: %ld ok, %ld errors, %.1f per second; ", ok, errors, elapsed > 0 ? (double)ok / elapsed : 0.0);
 	else
 		printf("submissions: %ld ok, %ld errors, %.1f per second; ", ok, errors,
 		       elapsed > 0 ? (double)ok / elapsed : 0.0);

@@ -13,6 +13,8 @@ echo "== slope cost: 000 Table 4, single against double point, 6x6 to 24x24 poin
 "$build"/bench/slope_cost_bench
 echo "== service: durable submissions, claims, log delay (bench/service.sh)"
 bash bench/service.sh "$build"
+echo "== service: listing latency at 100,000 jobs (bench/list.sh)"
+bash bench/list.sh "$build"
 echo "== materials: ns per stress update, elastic and plastic steps (bench/material_bench.c)"
 "$build"/bench/material_bench
 echo "== case validation: us per item at a tenth of each list's limit and at the limit (bench/case_validate_bench.c)"

@@ -7,6 +7,7 @@
  *   poro show ID
  *   poro logs [-f] ID
  *   poro cancel ID
+ *   poro rm ID                  (a finished job and everything stored for it)
  *   poro fetch ID [--out DIR]
  *
  * The server URL and token come from PORO_SERVER and PORO_TOKEN, else ~/.config/poro/config.
@@ -48,6 +49,7 @@ static int usage(void)
 		"       poro show ID\n"
 		"       poro logs [-f] ID\n"
 		"       poro cancel ID\n"
+		"       poro rm ID\n"
 		"       poro fetch ID [--out DIR]\n"
 		"server and token from PORO_SERVER and PORO_TOKEN, else ~/.config/poro/config\n");
 	return 2;
@@ -394,6 +396,47 @@ static int job_state(long long id, char *state, size_t size, long long *attempt)
 	return 0;
 }
 
+/* Where a follower is in the log. Bytes received are not log bytes once the server put a marker
+ * line in place of dropped bytes (docs/service.md §3, "Log cap"): the marker names the dropped
+ * offsets A..B, and the bytes after it continue at log offset B. A line counts as the marker only
+ * when A is the log offset at which the marker text starts, so a solver line that merely looks like
+ * one does not move the offset. */
+#define LOG_MARKER_PREFIX "[poro-server: log bytes "
+#define LOG_MARKER_MAX 400
+
+struct log_place {
+	long long start;          /* log offset the stream began at */
+	long long seen;           /* stream bytes of the lines passed so far, newlines included */
+	long long marker_log;     /* log offset after the last marker line, or -1 */
+	long long marker_stream;  /* stream bytes up to the end of that marker line */
+};
+
+/* The log offset reached after stream bytes of the current stream. */
+static long long place_offset(const struct log_place *p, long long stream_bytes)
+{
+	return p->marker_log >= 0 ? p->marker_log + (stream_bytes - p->marker_stream) : p->start + stream_bytes;
+}
+
+static int follow_line(const char *line, size_t len, void *user)
+{
+	struct log_place *p = user;
+	const char *m = memmem(line, len, LOG_MARKER_PREFIX, strlen(LOG_MARKER_PREFIX));
+	if (m) {
+		char text[LOG_MARKER_MAX];
+		size_t n = len - (size_t)(m - line) < sizeof text - 1 ? len - (size_t)(m - line) : sizeof text - 1;
+		memcpy(text, m, n);
+		text[n] = '\0';
+		long long from, to;
+		if (sscanf(text + strlen(LOG_MARKER_PREFIX), "%lld..%lld", &from, &to) == 2 &&
+		    from == place_offset(p, p->seen) + (m - line) && to >= from) {
+			p->marker_log = to;
+			p->marker_stream = p->seen + (long long)len + 1;
+		}
+	}
+	p->seen += (long long)len + 1;
+	return print_line(line, len, NULL);
+}
+
 /* Follows the log of every attempt until the job ends; a broken stream resumes at its offset. */
 static int follow_log(long long id)
 {
@@ -417,9 +460,10 @@ static int follow_log(long long id)
 		}
 		snprintf(path, sizeof path, "/v1/jobs/%lld/log?attempt=%lld&offset=%lld&follow=1", id, attempt, offset);
 		struct http_response r;
+		struct log_place place = { .start = offset, .marker_log = -1 };
 		long long got = 0;
-		long status = http_stream_lines(http, path, print_line, NULL, &got, &r);
-		offset += got;
+		long status = http_stream_lines(http, path, follow_line, &place, &got, &r);
+		offset = place_offset(&place, got);
 		if (status != 0 && !http_ok(&r))
 			return fail(&r);
 		http_response_release(&r);
@@ -455,21 +499,46 @@ static int cmd_logs(int argc, char **argv)
 	return rc;
 }
 
+/* The one argument ID of a command, sent as method to the path fmt makes of it: 0 with the 200
+ * answer in r, else the exit status after reporting (2 for a bad command line). */
+static int job_request(int argc, char **argv, const char *method, const char *fmt, long long *id,
+		       struct http_response *r)
+{
+	if (argc != 1 || parse_id(argv[0], id) < 0)
+		return usage();
+	char path[64];
+	snprintf(path, sizeof path, fmt, *id);
+	if (call(method, path, NULL, NULL, r) != 200)
+		return fail(r);
+	return 0;
+}
+
 static int cmd_cancel(int argc, char **argv)
 {
 	long long id;
-	if (argc != 1 || parse_id(argv[0], &id) < 0)
-		return usage();
-	char path[64];
-	snprintf(path, sizeof path, "/v1/jobs/%lld/cancel", id);
 	struct http_response r;
-	if (call("POST", path, NULL, NULL, &r) != 200)
-		return fail(&r);
+	int rc = job_request(argc, argv, "POST", "/v1/jobs/%lld/cancel", &id, &r);
+	if (rc)
+		return rc;
 	const char *state = json_get_str(r.json, "state", "?");
 	if (!strcmp(state, "cancelled"))
 		printf("job %lld cancelled\n", id);
 	else
 		printf("job %lld %s, cancel requested\n", id, state);
+	http_response_release(&r);
+	return 0;
+}
+
+static int cmd_rm(int argc, char **argv)
+{
+	long long id;
+	struct http_response r;
+	int rc = job_request(argc, argv, "DELETE", "/v1/jobs/%lld", &id, &r);
+	if (rc)
+		return rc;
+	printf("job %lld removed: %lld bytes freed (%lld files, %lld log chunks, %lld events)\n", id,
+	       json_get_int(r.json, "freed_bytes", 0), json_get_int(r.json, "files", 0),
+	       json_get_int(r.json, "log_chunks", 0), json_get_int(r.json, "events", 0));
 	http_response_release(&r);
 	return 0;
 }
@@ -587,6 +656,8 @@ int main(int argc, char **argv)
 		rc = cmd_logs(n, rest);
 	else if (!strcmp(cmd, "cancel"))
 		rc = cmd_cancel(n, rest);
+	else if (!strcmp(cmd, "rm"))
+		rc = cmd_rm(n, rest);
 	else if (!strcmp(cmd, "fetch"))
 		rc = cmd_fetch(n, rest);
 	else

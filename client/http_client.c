@@ -184,7 +184,8 @@ static size_t on_write(char *data, size_t size, size_t nmemb, void *user)
 				continue;
 			if (buffer_append(&t->line, data + start, i - start) < 0)
 				return 0;
-			t->bytes += (long long)(i - start + 1);
+			/* the whole line: its start may have come in an earlier piece */
+			t->bytes += (long long)t->line.len + 1;
 			if (t->line_fn(t->line.data ? t->line.data : "", t->line.len, t->line_user)) {
 				t->stopped = 1;
 				return 0;

@@ -13,6 +13,7 @@
 #include <string.h>
 
 #define CAP_MAX 10000000
+#define STORED_MAX (1LL << 60)   /* bytes */
 
 void admin_healthz(struct request *r)
 {
@@ -47,17 +48,18 @@ static int valid_user_name(const char *name)
 
 void admin_users_create(struct request *r)
 {
-	static const char *const keys[] = { "name", "role", "max_queued", "max_running", NULL };
+	static const char *const keys[] = { "name", "role", "max_queued", "max_running", "max_stored_bytes", NULL };
 	json_t *body = api_body_object(r);
 	if (!body)
 		return;
 	const char *name, *role_text;
-	long long max_queued, max_running;
+	long long max_queued, max_running, max_stored;
 	enum role role = ROLE_USER;
 	if (api_known_keys(r, body, keys) || api_string_member(r, body, "name", SERVER_NAME_MAX, 1, &name) ||
 	    api_string_member(r, body, "role", 16, 0, &role_text) ||
 	    api_int_member(r, body, "max_queued", 0, CAP_MAX, -1, &max_queued) ||
-	    api_int_member(r, body, "max_running", 0, CAP_MAX, -1, &max_running))
+	    api_int_member(r, body, "max_running", 0, CAP_MAX, -1, &max_running) ||
+	    api_int_member(r, body, "max_stored_bytes", 0, STORED_MAX, -1, &max_stored))
 		goto done;
 	if (!valid_user_name(name)) {
 		reply_fail(r, API_INVALID_REQUEST, "/name", "user name must match ^[A-Za-z0-9][A-Za-z0-9._@-]*$");
@@ -69,10 +71,13 @@ void admin_users_create(struct request *r)
 	}
 	json_t *user = NULL;
 	struct api_error err = { 0 };
-	if (store_user_create(r->srv->store, name, role, (int)max_queued, (int)max_running, &user, &err) != API_OK) {
+	if (store_user_create(r->srv->store, name, role, (int)max_queued, (int)max_running, &user, &err) != API_OK ||
+	    (max_stored >= 0 && store_user_set_max_stored(r->srv->store, name, max_stored, &err) != API_OK)) {
+		json_decref(user);
 		reply_error(r, &err);
 		goto done;
 	}
+	json_object_set_new(user, "max_stored_bytes", max_stored >= 0 ? json_integer(max_stored) : json_null());
 	reply_json(r, 201, user);
 done:
 	json_decref(body);

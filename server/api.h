@@ -14,6 +14,7 @@ void jobs_submit(struct request *r);
 void jobs_list(struct request *r);
 void jobs_show(struct request *r);
 void jobs_cancel(struct request *r);
+void jobs_delete(struct request *r);
 void jobs_probes(struct request *r);
 void logs_get(struct request *r);
 void files_get(struct request *r);

@@ -67,6 +67,7 @@ static const struct route ROUTES[] = {
 	{ "POST", "/v1/jobs", USER_ROLES, BODY_CASE, jobs_submit, 0, 0, 0, 0 },
 	{ "GET", "/v1/jobs", USER_ROLES, BODY_SMALL, jobs_list, 0, 0, 0, 0 },
 	{ "GET", "/v1/jobs/{id}", USER_ROLES, BODY_SMALL, jobs_show, 0, 0, 0, 0 },
+	{ "DELETE", "/v1/jobs/{id}", USER_ROLES, BODY_SMALL, jobs_delete, 0, 0, 0, 0 },
 	{ "POST", "/v1/jobs/{id}/cancel", USER_ROLES, BODY_SMALL, jobs_cancel, 0, 0, 0, 0 },
 	{ "GET", "/v1/jobs/{id}/log", USER_ROLES, BODY_SMALL, logs_get, 0, 0, 0, 0 },
 	{ "GET", "/v1/jobs/{id}/files/{name}", USER_ROLES, BODY_SMALL, files_get, 0, 0, 0, 0 },

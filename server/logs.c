@@ -1,7 +1,18 @@
 /*
  * logs.c - reading a job's log (GET /v1/jobs/{id}/log): the text of one attempt from an offset,
- * or with follow=1 a chunked stream that delivers new chunks as workers append them and ends when
- * the attempt ends (finish, expiry, cancel) or the server stops.
+ * streamed (chunked) with bounded memory per reader; without follow the stream ends at the end
+ * offset the log had when the request came (X-Log-Next-Offset), with follow=1 it delivers new
+ * chunks as workers append them and ends when the attempt ends (finish, expiry, cancel) or the
+ * server stops.
+ *
+ * Each call of the stream callback reads at most LOG_READ_BLOCK bytes of whole chunks through a
+ * read connection of the pool (store_log_read) and hands them out, so a reader holds one block,
+ * whatever the log's size. Where the read reaches bytes the cap dropped (store_worker.c), one
+ * marker line stands in their place, naming the dropped offsets A..B this reader skipped:
+ *   [poro-server: log bytes A..B of attempt N were dropped: an attempt keeps its first X and last Y (--max-log-bytes)]
+ * and the stream goes on with the bytes from offset B. Offsets stay log offsets: a client that
+ * resumes by counting bytes takes B as the offset after the marker line (cli/poro.c does), since
+ * the marker's own bytes are not log bytes.
  *
  * A follower blocks only its own connection thread (one thread per connection). It waits on
  * srv->log_cv, which the writer broadcasts after committing a log chunk or the end of an attempt,
@@ -20,20 +31,27 @@
 #define ATTEMPT_MAX 1000000
 #define OFFSET_MAX (1LL << 50)
 #define FOLLOW_POLL_MS 1000
+#define LOG_READ_BLOCK (256 * 1024)   /* bytes of chunks one callback reads from the store */
+#define MARKER_MAX 320
+#define MIB (1LL << 20)
 
-struct follow {
+struct log_reader {
 	struct server *srv;
-	long long id, offset;
+	long long id;
 	int attempt;
-	char *buf;                /* text read but not yet sent */
-	size_t size, sent;
+	long long pos;            /* log offset of the next byte to read */
+	long long until;          /* without follow: the end offset when the request came; -1 following */
+	struct log_block block;   /* text read, sent up to `sent` */
+	size_t sent;
+	char marker[MARKER_MAX];  /* a marker line waiting to go out before the block */
+	size_t marker_size, marker_sent;
 };
 
-static void follow_free(void *cls)
+static void reader_free(void *cls)
 {
-	struct follow *f = cls;
-	free(f->buf);
-	free(f);
+	struct log_reader *lr = cls;
+	log_block_release(&lr->block);
+	free(lr);
 }
 
 static void wait_for_chunk(struct server *srv, unsigned long long seq)
@@ -47,30 +65,79 @@ static void wait_for_chunk(struct server *srv, unsigned long long seq)
 	pthread_mutex_unlock(&srv->wake_lock);
 }
 
-static ssize_t follow_read(void *cls, uint64_t pos, char *out, size_t max)
+static void format_size(long long bytes, char out[32])
 {
-	struct follow *f = cls;
-	while (f->sent == f->size) {
-		free(f->buf);
-		f->buf = NULL;
-		f->size = f->sent = 0;
-		pthread_mutex_lock(&f->srv->wake_lock);
-		unsigned long long seq = f->srv->log_seq;
-		pthread_mutex_unlock(&f->srv->wake_lock);
-		int live = 0;
+	if (bytes % MIB == 0)
+		snprintf(out, 32, "%lld MiB", bytes / MIB);
+	else
+		snprintf(out, 32, "%lld bytes", bytes);
+}
+
+/* The marker line for the dropped offsets [from, to). */
+static void marker_set(struct log_reader *lr, long long from, long long to)
+{
+	long long cap = lr->srv->cfg.max_log_bytes;
+	char head[32], tail[32];
+	format_size(cap / 2, head);
+	format_size(cap - cap / 2, tail);
+	int n = snprintf(lr->marker, sizeof lr->marker,
+			 "[poro-server: log bytes %lld..%lld of attempt %d were dropped: an attempt keeps its first %s"
+			 " and last %s (--max-log-bytes)]\n", from, to, lr->attempt, head, tail);
+	lr->marker_size = n > 0 && (size_t)n < sizeof lr->marker ? (size_t)n : 0;
+	lr->marker_sent = 0;
+}
+
+/* Reads the next block (and the marker before it, if it starts past pos); 1 when there is
+ * something to send, 0 at the end of the stream, -1 on a database error. */
+static int reader_fill(struct log_reader *lr)
+{
+	for (;;) {
+		if (lr->until >= 0 && lr->pos >= lr->until)
+			return 0;
+		struct server *srv = lr->srv;
+		pthread_mutex_lock(&srv->wake_lock);
+		unsigned long long seq = srv->log_seq;
+		pthread_mutex_unlock(&srv->wake_lock);
 		struct api_error err = { 0 };
-		if (store_log_read(f->srv->store, f->id, &f->attempt, f->offset, &f->buf, &f->size, &live, &err) != API_OK)
-			return HTTP_STREAM_ERROR;
-		f->offset += (long long)f->size;
-		if (f->size)
-			break;
-		if (!live || f->srv->stopping)
-			return HTTP_STREAM_END;
-		wait_for_chunk(f->srv, seq);
+		if (store_log_read(srv->store, lr->id, lr->attempt, lr->pos, lr->until, LOG_READ_BLOCK, &lr->block,
+				   &err) != API_OK)
+			return -1;
+		lr->sent = 0;
+		long long at = lr->block.at;
+		if (lr->block.size == 0 && lr->until >= 0)
+			at = lr->until; /* everything up to the end asked for was dropped meanwhile */
+		if (at > lr->pos)
+			marker_set(lr, lr->pos, at);
+		lr->pos = at + (long long)lr->block.size;
+		if (lr->marker_size || lr->block.size)
+			return 1;
+		if (lr->until >= 0 || !lr->block.live || srv->stopping)
+			return 0;
+		wait_for_chunk(srv, seq);
 	}
-	size_t n = f->size - f->sent < max ? f->size - f->sent : max;
-	memcpy(out, f->buf + f->sent, n);
-	f->sent += n;
+}
+
+static ssize_t reader_stream(void *cls, uint64_t pos, char *out, size_t max)
+{
+	struct log_reader *lr = cls;
+	if (lr->marker_sent == lr->marker_size && lr->sent == lr->block.size) {
+		lr->marker_size = lr->marker_sent = 0;
+		int rc = reader_fill(lr);
+		if (rc <= 0)
+			return rc < 0 ? HTTP_STREAM_ERROR : HTTP_STREAM_END;
+	}
+	const char *from = lr->marker + lr->marker_sent;
+	size_t left = lr->marker_size - lr->marker_sent;
+	if (left == 0) {
+		from = lr->block.text + lr->sent;
+		left = lr->block.size - lr->sent;
+	}
+	size_t n = left < max ? left : max;
+	memcpy(out, from, n);
+	if (lr->marker_sent < lr->marker_size)
+		lr->marker_sent += n;
+	else
+		lr->sent += n;
 	return (ssize_t)n;
 }
 
@@ -82,29 +149,27 @@ void logs_get(struct request *r)
 	if (api_query_int(r, "attempt", 0, ATTEMPT_MAX, -1, &attempt) ||
 	    api_query_int(r, "offset", 0, OFFSET_MAX, 0, &offset) || api_query_int(r, "follow", 0, 1, 0, &follow))
 		return;
-	int at = (int)attempt;
-	if (follow) {
-		struct follow *f = calloc(1, sizeof *f);
-		if (!f) {
-			reply_fail(r, API_INTERNAL, "", "out of memory");
-			return;
-		}
-		*f = (struct follow){ .srv = r->srv, .id = r->id, .offset = offset, .attempt = at };
-		reply_stream(r, 200, "text/plain; charset=utf-8", follow_read, f, follow_free);
-		return;
-	}
-	char *text = NULL;
-	size_t size = 0;
-	int live = 0;
+	struct log_info info;
 	struct api_error err = { 0 };
-	if (store_log_read(r->srv->store, r->id, &at, offset, &text, &size, &live, &err) != API_OK) {
+	if (store_log_info(r->srv->store, r->id, (int)attempt, &info, &err) != API_OK) {
 		reply_error(r, &err);
 		return;
 	}
+	struct log_reader *lr = calloc(1, sizeof *lr);
+	if (!lr) {
+		reply_fail(r, API_INTERNAL, "", "out of memory");
+		return;
+	}
+	*lr = (struct log_reader){ .srv = r->srv, .id = r->id, .attempt = info.attempt, .pos = offset,
+				   .until = follow ? -1 : (info.end > offset ? info.end : offset) };
 	char value[32];
-	snprintf(value, sizeof value, "%d", at);
+	snprintf(value, sizeof value, "%d", info.attempt);
 	reply_header(r, "X-Log-Attempt", value);
-	snprintf(value, sizeof value, "%lld", offset + (long long)size);
-	reply_header(r, "X-Log-Next-Offset", value);
-	reply_text(r, 200, "text/plain; charset=utf-8", text, size);
+	snprintf(value, sizeof value, "%lld", info.dropped_to - info.dropped_from);
+	reply_header(r, "X-Log-Dropped-Bytes", value);
+	if (!follow) {
+		snprintf(value, sizeof value, "%lld", lr->until);
+		reply_header(r, "X-Log-Next-Offset", value);
+	}
+	reply_stream(r, 200, "text/plain; charset=utf-8", reader_stream, lr, reader_free);
 }

@@ -8,6 +8,7 @@
  * Every option is one row of OPTIONS: the flag name, which is also the key in the config file
  * ("name = value" lines, '#' comments), the field it sets, its default and its help text.
  */
+#include "file_sweep.h"
 #include "http.h"
 #include "metrics.h"
 #include "reaper.h"
@@ -68,6 +69,8 @@ static const struct option_def OPTIONS[] = {
 	INT_OPT("group-commit-max", group_commit_max, 1, 100000, "most write requests in one transaction (default 1024)"),
 	INT_OPT("max-job-threads", max_job_threads, 1, 256, "most threads a job may ask for (default 64)"),
 	TEXT_OPT("access-log", access_log, "append 'METHOD ROUTE STATUS MILLISECONDS' per request to FILE (default none)"),
+	LONG_OPT("max-log-bytes", max_log_bytes, 65536, 1LL << 50, "log text kept per attempt: its first and last half (default 67108864)"),
+	LONG_OPT("user-max-stored-bytes", user_max_stored_bytes, 0, 1LL << 60, "default per-user cap on stored bytes (cases, logs, files), 0 = unlimited (default 2147483648)"),
 };
 #define OPTION_COUNT (sizeof OPTIONS / sizeof OPTIONS[0])
 
@@ -79,6 +82,7 @@ static const struct server_config CONFIG_DEFAULTS = {
 	.max_upload_bytes = 4LL << 30, .lease_seconds = 30, .max_attempts = 5, .user_max_queued = 10000,
 	.user_max_running = 0, .max_backoff_seconds = 60, .group_commit_max = 1024,
 	.max_job_threads = 64,
+	.max_log_bytes = 64LL << 20, .user_max_stored_bytes = 2LL << 30,
 };
 
 static void usage(FILE *out)
@@ -285,6 +289,20 @@ static void raise_descriptor_limit(void)
 	}
 }
 
+/* Removes what interrupted uploads and interrupted deletions left in STATE/files, before the
+ * first request (file_sweep.c); one line says what. */
+static void sweep_files(struct server *srv)
+{
+	struct sweep_counts n;
+	if (file_sweep_startup(srv->cfg.state, srv->store, &n) != 0) {
+		fprintf(stderr, "poro-server: cannot sweep '%s/files': %s\n", srv->cfg.state, strerror(errno));
+		return;
+	}
+	fprintf(stderr, "poro-server: start-up sweep of '%s/files': removed temporary upload files: %lld (%lld bytes); "
+		"directories of deleted jobs: %lld (%lld bytes)\n", srv->cfg.state, n.tmp_files, n.tmp_bytes, n.job_dirs,
+		n.job_bytes);
+}
+
 static int serve(struct server *srv)
 {
 	raise_descriptor_limit();
@@ -303,6 +321,7 @@ static int serve(struct server *srv)
 	if (open_store(&srv->cfg, srv, &srv->store) != 0)
 		return 1;
 	store_set_commit_observer(srv->store, metrics_observe_commit, srv->metrics);
+	sweep_files(srv);
 	char url[512], msg[SERVER_MESSAGE_MAX];
 	void *daemon = http_start(srv, url, sizeof url, msg, sizeof msg);
 	if (!daemon) {

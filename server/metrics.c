@@ -3,6 +3,7 @@
  * (metrics.h). Histograms have fixed bucket bounds in seconds, chosen per quantity (commit times
  * are milliseconds, job durations hours). Worker heartbeat ages are kept for at most
  * WORKERS_MAX worker ids; the least recently seen is replaced, so the label set stays bounded.
+ * Job counts per state and the cost of job listings are read from the store at scrape time.
  */
 #include "metrics.h"
 #include "store.h"
@@ -193,6 +194,23 @@ static void put_histogram(struct text *t, const struct histogram *h)
 	    h->name, h->total);
 }
 
+/* The cost of job listings, as SQLite counts it: a page that cost more with a bigger table
+ * would show here without any timing. */
+static void put_list_stats(struct text *t, struct store *store)
+{
+	struct list_stats ls;
+	store_list_stats(store, &ls);
+	put(t, "# HELP poro_job_list_requests_total job listings (GET /v1/jobs) answered from the database\n"
+	       "# TYPE poro_job_list_requests_total counter\nporo_job_list_requests_total %llu\n", ls.requests);
+	put(t, "# HELP poro_job_list_vm_steps_total SQLite virtual machine steps of job listings\n"
+	       "# TYPE poro_job_list_vm_steps_total counter\nporo_job_list_vm_steps_total %llu\n", ls.vm_steps);
+	put(t, "# HELP poro_job_list_fullscan_steps_total steps of job listings in full table scans\n"
+	       "# TYPE poro_job_list_fullscan_steps_total counter\nporo_job_list_fullscan_steps_total %llu\n",
+	    ls.fullscan_steps);
+	put(t, "# HELP poro_job_list_sorts_total sorts done by job listings\n"
+	       "# TYPE poro_job_list_sorts_total counter\nporo_job_list_sorts_total %llu\n", ls.sorts);
+}
+
 char *metrics_render(struct metrics *m, struct store *store, size_t *size)
 {
 	struct text t = { 0 };
@@ -203,6 +221,7 @@ char *metrics_render(struct metrics *m, struct store *store, size_t *size)
 	put(&t, "# HELP poro_jobs jobs per state\n# TYPE poro_jobs gauge\n");
 	for (int i = 0; have_counts && i < JOB_STATE_COUNT; i++)
 		put(&t, "poro_jobs{state=\"%s\"} %lld\n", job_state_name((enum job_state)i), counts[i]);
+	put_list_stats(&t, store);
 	long long now = now_ms();
 	pthread_mutex_lock(&m->lock);
 	put_histogram(&t, &m->claim);

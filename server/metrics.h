@@ -1,7 +1,8 @@
 /*
  * metrics.h - the server's Prometheus metrics (docs/service.md §4): counters and histograms kept
  * in memory by the handlers and the writer, and the text exposition format for GET /metrics.
- * Job counts per state are read from the database at scrape time. Thread-safe.
+ * Job counts per state and the cost of job listings (SQLite VM steps, full-scan steps, sorts) are
+ * read from the store at scrape time. Thread-safe.
  */
 #ifndef PORO_METRICS_H
 #define PORO_METRICS_H

@@ -9,7 +9,9 @@
  * never edit one that has shipped.
  *
  * Times are milliseconds since the epoch (INTEGER). users.queued and users.running are counters
- * kept by job_transition() (store_jobs.c) so that quota checks and fair share need no scans.
+ * kept by job_transition() (store_jobs.c) so that quota checks and fair share need no scans;
+ * job_counts (per state), jobs.stored_bytes and users.stored_bytes (store_quota.c) and
+ * log_attempts (store_worker.c) are kept the same way, in the writes that change what they count.
  */
 #include "store_internal.h"
 
@@ -88,6 +90,37 @@ static const char *const MIGRATIONS[] = {
 	"  sha256 TEXT NOT NULL,"
 	"  created_at INTEGER NOT NULL,"
 	"  PRIMARY KEY (job_id, name, attempt)) WITHOUT ROWID;",
+
+	/* 2: listing at any depth and size (an index per listing shape, so every page is a range
+	 * scan), the log cap's bookkeeping per attempt, stored bytes per job and user with an
+	 * optional per-user quota, job counts per state for /metrics, an index to delete a job's
+	 * idempotency keys, and job ids that are never reused once a job is deleted */
+	"CREATE INDEX jobs_user ON jobs (user_id, id);"
+	"CREATE INDEX jobs_user_state ON jobs (user_id, state, id);"
+	"CREATE INDEX jobs_state_id ON jobs (state, id);"
+	"CREATE INDEX idempotency_job ON idempotency (job_id);"
+	"CREATE TABLE log_attempts ("
+	"  job_id INTEGER NOT NULL REFERENCES jobs(id),"
+	"  attempt INTEGER NOT NULL,"
+	"  end_offset INTEGER NOT NULL,"     /* just past the last byte appended: the next chunk's offset */
+	"  dropped_from INTEGER NOT NULL DEFAULT 0," /* chunks in [dropped_from, dropped_to) were deleted */
+	"  dropped_to INTEGER NOT NULL DEFAULT 0,"
+	"  PRIMARY KEY (job_id, attempt)) WITHOUT ROWID;"
+	"INSERT INTO log_attempts (job_id, attempt, end_offset)"
+	"  SELECT job_id, attempt, max(offset + length(text)) FROM log_chunks GROUP BY job_id, attempt;"
+	"ALTER TABLE users ADD COLUMN stored_bytes INTEGER NOT NULL DEFAULT 0;"
+	"ALTER TABLE users ADD COLUMN max_stored_bytes INTEGER;" /* NULL: the server default */
+	"ALTER TABLE jobs ADD COLUMN stored_bytes INTEGER NOT NULL DEFAULT 0;" /* case + log + files */
+	"UPDATE jobs SET stored_bytes = length(CAST(case_json AS BLOB))"
+	"  + coalesce((SELECT sum(length(l.text)) FROM log_chunks l WHERE l.job_id = jobs.id), 0)"
+	"  + coalesce((SELECT sum(f.size) FROM files f WHERE f.job_id = jobs.id), 0);"
+	"UPDATE users SET stored_bytes = coalesce((SELECT sum(j.stored_bytes) FROM jobs j WHERE j.user_id = users.id), 0);"
+	"CREATE TABLE job_counts (state TEXT PRIMARY KEY, jobs INTEGER NOT NULL) WITHOUT ROWID;"
+	"INSERT INTO job_counts (state, jobs) SELECT s.state, (SELECT count(*) FROM jobs j WHERE j.state = s.state)"
+	"  FROM (SELECT 'queued' AS state UNION ALL SELECT 'running' UNION ALL SELECT 'succeeded'"
+	"        UNION ALL SELECT 'failed' UNION ALL SELECT 'cancelled') s;"
+	"CREATE TABLE counters (name TEXT PRIMARY KEY, value INTEGER NOT NULL) WITHOUT ROWID;"
+	"INSERT INTO counters (name, value) VALUES ('job_id', coalesce((SELECT max(id) FROM jobs), 0));",
 };
 
 #define MIGRATION_COUNT ((int)(sizeof MIGRATIONS / sizeof MIGRATIONS[0]))

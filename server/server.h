@@ -46,6 +46,8 @@ struct server_config {
 	int group_commit_max;         /* most write requests in one transaction */
 	int max_job_threads;          /* most threads a job may ask for (1..256 on the wire) */
 	char access_log[SERVER_STATE_MAX]; /* one line per answered request, or "" for none */
+	long long max_log_bytes;      /* log text kept per attempt: its first and last half, bytes */
+	long long user_max_stored_bytes; /* default per-user cap on stored bytes; 0 = unlimited */
 };
 
 /*      code                        HTTP  name on the wire */
@@ -64,6 +66,7 @@ struct server_config {
 	X(API_REQUEST_TIMEOUT,      408, "request_timeout")                  \
 	X(API_IDEMPOTENCY_CONFLICT, 409, "idempotency_conflict")             \
 	X(API_NOT_CANCELLABLE,      409, "not_cancellable")                  \
+	X(API_NOT_DELETABLE,        409, "not_deletable")                    \
 	X(API_STALE_ATTEMPT,        409, "stale_attempt")                    \
 	X(API_LOG_GAP,              409, "log_gap")                          \
 	X(API_ALREADY_EXISTS,       409, "already_exists")                   \

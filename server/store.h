@@ -51,18 +51,45 @@ struct job_submit {
 	int priority, threads, wall_time_seconds;
 };
 /* Stores a queued job and its "submitted" event. *created is 1 for a new job, 0 when the
- * idempotency key returned an existing one. API_IDEMPOTENCY_CONFLICT, API_QUOTA_EXCEEDED. */
+ * idempotency key returned an existing one. API_IDEMPOTENCY_CONFLICT; API_QUOTA_EXCEEDED when the
+ * user has its cap of queued jobs, or when the case text would take the user's stored bytes past
+ * its quota (users.max_stored_bytes, else cfg->user_max_stored_bytes; 0 = none). */
 enum api_code store_job_submit(struct store *s, const struct job_submit *in, json_t **job, int *created,
 			       struct api_error *err);
 /* A job the principal may see (its own; every job for admins), with files and events when full. */
 enum api_code store_job_get(struct store *s, const struct principal *who, long long id, int full, json_t **job,
 			    struct api_error *err);
-/* Newest first; states is a bit mask of JOB_STATE_* (0 = all); after = 0 for the first page. */
+/* Newest first; states is a bit mask of JOB_STATE_* (0 = all); after = 0 for the first page. Every
+ * combination is an index range scan that stops after limit + 1 rows, without a sort. */
 enum api_code store_job_list(struct store *s, const struct principal *who, unsigned states, int limit,
 			     long long after, json_t **page, struct api_error *err);
 /* Cancels a queued job now, or requests cancel of a running one. API_NOT_CANCELLABLE. */
 enum api_code store_job_cancel(struct store *s, const struct principal *who, long long id, json_t **job,
 			       struct api_error *err);
+/* What deleting a job freed: its stored bytes (case, log text, files) and the rows removed. */
+struct job_freed {
+	long long bytes, files, log_chunks, events, idempotency_keys;
+};
+/* Deletes a job in a terminal state with its log, file index rows, idempotency keys and events,
+ * and subtracts its bytes from its owner's (store_delete.c). The caller removes the files on disk
+ * after this returns API_OK. API_NOT_FOUND (also for another user's job), API_NOT_DELETABLE for a
+ * queued or running job. */
+enum api_code store_job_delete(struct store *s, const struct principal *who, long long id, struct job_freed *freed,
+			       struct api_error *err);
+/* 1 when a job with this id exists, 0 when not, -1 when the database cannot say. */
+int store_job_exists(struct store *s, long long id);
+
+/* What listings cost, summed over every store_job_list since start: SQLite VM steps, steps of
+ * full table scans and sorts (sqlite3_stmt_status), for /metrics. */
+struct list_stats {
+	unsigned long long requests, vm_steps, fullscan_steps, sorts;
+};
+void store_list_stats(struct store *s, struct list_stats *out);
+
+/* Sets a user's own cap on stored bytes (< 0: back to the server default). API_INVALID_REQUEST for
+ * an unknown user. */
+enum api_code store_user_set_max_stored(struct store *s, const char *name, long long max_stored_bytes,
+					struct api_error *err);
 
 #define JOB_STATE_MAP(X) X(QUEUED, "queued") X(RUNNING, "running") X(SUCCEEDED, "succeeded") \
 	X(FAILED, "failed") X(CANCELLED, "cancelled")
@@ -74,7 +101,7 @@ enum job_state {
 };
 const char *job_state_name(enum job_state st);
 int job_state_parse(const char *name, enum job_state *st);   /* 0, or -1 */
-/* Jobs per state, for /metrics. */
+/* Jobs per state, for /metrics (kept as counters: no scan). */
 enum api_code store_job_counts(struct store *s, long long counts[JOB_STATE_COUNT], struct api_error *err);
 
 /* ---- jobs, worker side (store_worker.c) ----
@@ -93,19 +120,48 @@ enum api_code store_claim(struct store *s, struct job_claim *in, json_t **job, s
 enum api_code store_heartbeat(struct store *s, const struct principal *who, long long id, int attempt,
 			      json_t *progress, const char *solver_version, int *cancel, long long *lease_expires_ms,
 			      struct api_error *err);
-/* Appends text at offset of (id, attempt)'s log; idempotent by offset; API_LOG_GAP. */
+/* Appends text at offset of (id, attempt)'s log; idempotent by offset; API_LOG_GAP. When the
+ * attempt's stored text would exceed cfg->max_log_bytes, the chunks between its first and last
+ * half are deleted in the same write (store_worker.c says how). API_TOO_LARGE for a chunk over
+ * 1 MiB. */
 enum api_code store_log_append(struct store *s, const struct principal *who, long long id, int attempt,
 			       long long offset, const char *text, size_t size, long long *next_offset,
 			       struct api_error *err);
-/* Log text of an attempt from offset (malloc'ed, *size bytes) and whether the attempt is still live.
- * *attempt < 0 means the job's current attempt (written back). Visibility is the caller's check. */
-enum api_code store_log_read(struct store *s, long long id, int *attempt, long long offset, char **text,
-			     size_t *size, int *live, struct api_error *err);
+/* An attempt's log as it stands: the attempt (a negative one asked for means the job's current
+ * attempt), whether it is still live, its end offset (the bytes ever appended) and the range
+ * [dropped_from, dropped_to) whose chunks were dropped (equal when none). */
+struct log_info {
+	int attempt, live;
+	long long end, dropped_from, dropped_to;
+};
+/* API_NOT_FOUND for a missing job; visibility is the caller's check. */
+enum api_code store_log_info(struct store *s, long long id, int attempt, struct log_info *info,
+			     struct api_error *err);
+/* A piece of stored log text: text[0..size) holds the bytes from offset at on, where at is the
+ * offset asked for, or the start of the next stored chunk when that offset was dropped (so at >
+ * the offset asked for says "bytes offset..at were dropped"). The buffer (text, cap) belongs to
+ * the caller, is reused by the next read and freed by log_block_release. */
+struct log_block {
+	char *text;
+	size_t size, cap;
+	long long at;
+	long long end;                /* the attempt's end offset at the time of the read */
+	int live;                     /* the attempt was still live at the time of the read */
+};
+/* Reads contiguous text of (id, attempt >= 1) from offset, stopping before offset until (< 0: no
+ * limit), at a dropped range, or once about max bytes are read (whole chunks: at most max plus
+ * one chunk, since a chunk is never split across reads). One read connection of the pool, taken
+ * and given back within the call. */
+enum api_code store_log_read(struct store *s, long long id, int attempt, long long offset, long long until,
+			     size_t max, struct log_block *b, struct api_error *err);
+void log_block_release(struct log_block *b);
 /* Read-only lease check before an upload starts; attempt < 0 accepts the current attempt. */
 enum api_code store_lease_check(struct store *s, const struct principal *who, long long id, int attempt,
 				int *current_attempt, struct api_error *err);
 /* Renames tmp_path to final_path and indexes the file, in one write, only if (id, attempt) still
- * holds the lease; the rename happens in the writer so a stale attempt can never replace a file. */
+ * holds the lease; the rename happens in the writer so a stale attempt can never replace a file.
+ * The file's size counts towards its job's and owner's stored bytes (a new version of the same
+ * name and attempt replaces the old one's size). */
 enum api_code store_file_commit(struct store *s, const struct principal *who, long long id, int attempt,
 				const char *name, long long size, const char *sha256, const char *tmp_path,
 				const char *final_path, struct api_error *err);

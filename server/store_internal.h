@@ -15,7 +15,7 @@
 
 #include "store.h"
 
-#define STMT_CACHE_MAX 64
+#define STMT_CACHE_MAX 128
 
 struct conn {
 	sqlite3 *db;
@@ -44,6 +44,8 @@ struct store {
 
 	void (*observe_commit)(void *cls, double seconds);
 	void *observe_cls;
+
+	struct list_stats list;               /* under lock: the cost of listings (store_job_list) */
 };
 
 typedef enum api_code (*write_fn)(struct store *s, struct conn *c, void *arg, struct api_error *err);
@@ -94,6 +96,13 @@ enum api_code job_transition(struct conn *c, long long id, enum job_state from, 
 enum api_code job_event(struct conn *c, long long id, enum job_state from, enum job_state to, int attempt,
 			const char *actor, const char *detail, struct api_error *err);
 
+
+/* ---- stored bytes (store_quota.c) ---- */
+/* Adds delta bytes (negative: freed) to a job's stored_bytes and to its owner's. */
+enum api_code stored_bytes_add(struct conn *c, long long job_id, long long delta, struct api_error *err);
+/* API_QUOTA_EXCEEDED when adding bytes to user's stored bytes would pass its quota. */
+enum api_code stored_quota_check(struct store *s, struct conn *c, long long user, long long bytes,
+				 struct api_error *err);
 
 /* ---- shared lease helpers (store_worker.c) ---- */
 /* API_OK when (id, attempt) is the running lease held by who (attempt < 0: any current attempt);

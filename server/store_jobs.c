@@ -1,14 +1,16 @@
 /*
- * store_jobs.c - jobs as users see them (store.h): submit with idempotency keys and the queued
- * cap, get, list, cancel, counts; and the helpers every job write shares: job_transition(), the
- * one place a job changes state, which also keeps the owner's queued/running counters and writes
- * the event row, and the JSON form of a job (docs/service.md §3).
+ * store_jobs.c - jobs as users see them (store.h): submit with idempotency keys, the queued cap
+ * and the storage quota, get, list (index range scans, see "listing" below), cancel, counts; and
+ * the helpers every job write shares: job_transition(), the one place a job changes state, which
+ * also keeps the owner's queued/running counters and job_counts and writes the event row, and
+ * the JSON form of a job (docs/service.md §3).
  *
  * Visibility: a user sees only its own jobs, an admin every job; another user's job is reported
  * exactly like a missing one (API_NOT_FOUND), so ids reveal nothing.
  */
 #include "store_internal.h"
 
+#include <limits.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -68,6 +70,32 @@ static const char SQL_FILES[] =
 static const char SQL_EVENTS[] =
 	"SELECT at, from_state, to_state, attempt, actor, detail FROM events WHERE job_id = ?1 ORDER BY id";
 
+static const char SQL_LOGS[] =
+	"SELECT attempt, end_offset, dropped_to - dropped_from FROM log_attempts WHERE job_id = ?1 ORDER BY attempt";
+
+/* "stored_bytes" (case, log text and files) and "logs": [{"attempt", "bytes", "dropped_bytes"}]. */
+static enum api_code add_storage(struct conn *c, long long id, json_t *job, struct api_error *err)
+{
+	sqlite3_stmt *st = conn_stmt(c, "SELECT stored_bytes FROM jobs WHERE id = ?1");
+	if (!st)
+		return db_fail(c, err, "reading stored bytes");
+	sqlite3_bind_int64(st, 1, id);
+	json_object_set_new(job, "stored_bytes", json_integer(sqlite3_step(st) == SQLITE_ROW ?
+							      sqlite3_column_int64(st, 0) : 0));
+	sqlite3_reset(st);
+	json_t *logs = json_array();
+	json_object_set_new(job, "logs", logs);
+	if (!(st = conn_stmt(c, SQL_LOGS)))
+		return db_fail(c, err, "reading logs");
+	sqlite3_bind_int64(st, 1, id);
+	while (sqlite3_step(st) == SQLITE_ROW)
+		json_array_append_new(logs, json_pack("{s:i, s:I, s:I}", "attempt", sqlite3_column_int(st, 0),
+						      "bytes", (json_int_t)sqlite3_column_int64(st, 1),
+						      "dropped_bytes", (json_int_t)sqlite3_column_int64(st, 2)));
+	sqlite3_reset(st);
+	return API_OK;
+}
+
 static enum api_code add_details(struct conn *c, long long id, json_t *job, struct api_error *err)
 {
 	json_t *files = json_array(), *events = json_array();
@@ -93,7 +121,7 @@ static enum api_code add_details(struct conn *c, long long id, json_t *job, stru
 							"attempt", sqlite3_column_int(st, 3), "actor",
 							col_json_text(st, 4), "detail", col_json_text(st, 5)));
 	sqlite3_reset(st);
-	return API_OK;
+	return add_storage(c, id, job, err);
 }
 
 /* Loads a job; *owner gets its user id (for visibility checks). */
@@ -176,7 +204,13 @@ enum api_code job_transition(struct conn *c, long long id, enum job_state from, 
 	sqlite3_reset(st);
 	if (rc != SQLITE_DONE)
 		return db_fail(c, err, "updating a user's counters");
-	return job_event(c, id, from, to, attempt, actor, detail, err);
+	st = conn_stmt(c, "UPDATE job_counts SET jobs = jobs + (state = ?2) - (state = ?1) WHERE state IN (?1, ?2)");
+	if (!st)
+		return db_fail(c, err, "preparing a job count update");
+	sqlite3_bind_text(st, 1, job_state_name(from), -1, SQLITE_STATIC);
+	sqlite3_bind_text(st, 2, job_state_name(to), -1, SQLITE_STATIC);
+	enum api_code done = step_done(c, st, err, "counting jobs per state");
+	return done != API_OK ? done : job_event(c, id, from, to, attempt, actor, detail, err);
 }
 
 /* ---- submit ---- */
@@ -228,6 +262,20 @@ static enum api_code check_quota(struct store *s, struct conn *c, long long user
 	return API_OK;
 }
 
+/* The next job id: one past the highest ever given, so the id of a deleted job is never reused. */
+static enum api_code next_job_id(struct conn *c, long long *id, struct api_error *err)
+{
+	sqlite3_stmt *st = conn_stmt(c, "UPDATE counters SET value = value + 1 WHERE name = 'job_id' RETURNING value");
+	if (!st)
+		return db_fail(c, err, "preparing a job id");
+	int rc = sqlite3_step(st);
+	*id = rc == SQLITE_ROW ? sqlite3_column_int64(st, 0) : 0;
+	if (rc == SQLITE_ROW)
+		rc = sqlite3_step(st); /* a RETURNING statement completes its update on the step that returns DONE */
+	sqlite3_reset(st);
+	return rc == SQLITE_DONE && *id > 0 ? API_OK : db_fail(c, err, "allocating a job id");
+}
+
 static enum api_code submit_run(struct store *s, struct conn *c, void *arg, struct api_error *err)
 {
 	struct submit_op *op = arg;
@@ -238,13 +286,18 @@ static enum api_code submit_run(struct store *s, struct conn *c, void *arg, stru
 		if ((rc = existing_key(c, op, &found, err)) != API_OK || found)
 			return rc;
 	}
-	if ((rc = check_quota(s, c, in->who->user_id, err)) != API_OK)
+	long long case_bytes = (long long)strlen(in->case_json), id = 0;
+	if ((rc = check_quota(s, c, in->who->user_id, err)) != API_OK ||
+	    (rc = stored_quota_check(s, c, in->who->user_id, case_bytes, err)) != API_OK ||
+	    (rc = next_job_id(c, &id, err)) != API_OK)
 		return rc;
 	sqlite3_stmt *st = conn_stmt(c, "INSERT INTO jobs (user_id, name, state, priority, threads, wall_time_seconds,"
-					" case_json, case_sha256, created_at, queued_at)"
-					" VALUES (?1, ?2, 'queued', ?3, ?4, ?5, ?6, ?7, ?8, ?8)");
+					" case_json, case_sha256, created_at, queued_at, id, stored_bytes)"
+					" VALUES (?1, ?2, 'queued', ?3, ?4, ?5, ?6, ?7, ?8, ?8, ?9, ?10)");
 	if (!st)
 		return db_fail(c, err, "preparing a job insert");
+	sqlite3_bind_int64(st, 9, id);
+	sqlite3_bind_int64(st, 10, case_bytes);
 	sqlite3_bind_int64(st, 1, in->who->user_id);
 	if (in->name)
 		sqlite3_bind_text(st, 2, in->name, -1, SQLITE_STATIC);
@@ -258,15 +311,18 @@ static enum api_code submit_run(struct store *s, struct conn *c, void *arg, stru
 	sqlite3_reset(st);
 	if (step != SQLITE_DONE)
 		return db_fail(c, err, "inserting a job");
-	long long id = sqlite3_last_insert_rowid(c->db);
-	st = conn_stmt(c, "UPDATE users SET queued = queued + 1 WHERE id = ?1");
+	st = conn_stmt(c, "UPDATE users SET queued = queued + 1, stored_bytes = stored_bytes + ?2 WHERE id = ?1");
 	if (!st)
 		return db_fail(c, err, "preparing a counter update");
 	sqlite3_bind_int64(st, 1, in->who->user_id);
+	sqlite3_bind_int64(st, 2, case_bytes);
 	step = sqlite3_step(st);
 	sqlite3_reset(st);
 	if (step != SQLITE_DONE)
 		return db_fail(c, err, "counting a queued job");
+	st = conn_stmt(c, "UPDATE job_counts SET jobs = jobs + 1 WHERE state = 'queued'");
+	if (!st || (rc = step_done(c, st, err, "counting jobs per state")) != API_OK)
+		return st ? rc : db_fail(c, err, "preparing a job count update");
 	if ((rc = job_event(c, id, (enum job_state)-1, JOB_QUEUED, 0, in->who->name, "submitted", err)) != API_OK)
 		return rc;
 	if (in->idempotency_key) {
@@ -304,7 +360,7 @@ enum api_code store_job_submit(struct store *s, const struct job_submit *in, jso
 	return API_OK;
 }
 
-/* ---- get, list, counts ---- */
+/* ---- get ---- */
 
 enum api_code store_job_get(struct store *s, const struct principal *who, long long id, int full, json_t **job,
 			    struct api_error *err)
@@ -324,44 +380,126 @@ enum api_code store_job_get(struct store *s, const struct principal *who, long l
 	return *job ? API_OK : err->code;
 }
 
+/* ---- listing ----
+ *
+ * Every listing is one or more index range scans in id order, each LIMITed to limit + 1 rows,
+ * so a page costs the same whatever the table's size and the page's depth (after=):
+ *   admin, all states:  the rowid range id < after                  (INTEGER PRIMARY KEY)
+ *   user, all states:   user_id = ? AND id < after                   (jobs_user)
+ *   admin, some states: per state, state = ? AND id < after          (jobs_state_id)
+ *   user, some states:  per state, user_id = ? AND state = ? AND id < after (jobs_user_state)
+ * With a state filter, one cursor per state asked for is merged here by id, newest first: SQLite
+ * would sort the rows of a UNION ALL of LIMITed subqueries (EXPLAIN QUERY PLAN shows a temporary
+ * B-tree per arm), the merge needs none. The VM steps, full-scan steps and sorts of the
+ * statements are added to s->list for /metrics, which is how the tests see the cost. */
+
+#define LIST_FROM "SELECT " JOB_COLUMNS "FROM jobs j JOIN users u ON u.id = j.user_id WHERE "
+#define LIST_ORDER " AND j.id < ?2 ORDER BY j.id DESC LIMIT ?3"
+static const char SQL_LIST_ALL[] = LIST_FROM "?1 = ?1" LIST_ORDER;
+static const char SQL_LIST_USER[] = LIST_FROM "j.user_id = ?1" LIST_ORDER;
+#define LIST_STATE_SQL(c, n) LIST_FROM "?1 = ?1 AND j.state = '" n "'" LIST_ORDER,
+static const char *const SQL_LIST_STATE[JOB_STATE_COUNT] = { JOB_STATE_MAP(LIST_STATE_SQL) };
+#define LIST_USER_STATE_SQL(c, n) LIST_FROM "j.user_id = ?1 AND j.state = '" n "'" LIST_ORDER,
+static const char *const SQL_LIST_USER_STATE[JOB_STATE_COUNT] = { JOB_STATE_MAP(LIST_USER_STATE_SQL) };
+
+struct list_cursor {
+	sqlite3_stmt *st;
+	int row;                  /* st holds a row */
+};
+
+static void list_cost(struct list_stats *cost, sqlite3_stmt *st)
+{
+	cost->vm_steps += (unsigned long long)sqlite3_stmt_status(st, SQLITE_STMTSTATUS_VM_STEP, 1);
+	cost->fullscan_steps += (unsigned long long)sqlite3_stmt_status(st, SQLITE_STMTSTATUS_FULLSCAN_STEP, 1);
+	cost->sorts += (unsigned long long)sqlite3_stmt_status(st, SQLITE_STMTSTATUS_SORT, 1);
+}
+
+/* Opens the cursors of a listing (one, or one per state asked for); -1 on a database error. */
+static int list_open(struct conn *c, const struct principal *who, unsigned states, int limit, long long after,
+		     struct list_cursor cur[JOB_STATE_COUNT], int *count)
+{
+	int admin = who->role == ROLE_ADMIN;
+	*count = 0;
+	for (int i = 0; i < (states ? JOB_STATE_COUNT : 1); i++) {
+		if (states && !(states & (1u << i)))
+			continue;
+		const char *sql = states ? (admin ? SQL_LIST_STATE[i] : SQL_LIST_USER_STATE[i])
+					 : (admin ? SQL_LIST_ALL : SQL_LIST_USER);
+		sqlite3_stmt *st = conn_stmt(c, sql);
+		if (!st)
+			return -1;
+		sqlite3_bind_int64(st, 1, admin ? 0 : who->user_id);
+		sqlite3_bind_int64(st, 2, after > 0 ? after : LLONG_MAX);
+		sqlite3_bind_int(st, 3, limit + 1);
+		cur[*count].st = st;
+		cur[*count].row = sqlite3_step(st) == SQLITE_ROW;
+		(*count)++;
+	}
+	return 0;
+}
+
+/* The cursor whose row has the highest id, or -1 when all are done. */
+static int list_newest(struct list_cursor *cur, int count)
+{
+	int best = -1;
+	for (int i = 0; i < count; i++)
+		if (cur[i].row && (best < 0 || sqlite3_column_int64(cur[i].st, 0) >
+						       sqlite3_column_int64(cur[best].st, 0)))
+			best = i;
+	return best;
+}
+
 enum api_code store_job_list(struct store *s, const struct principal *who, unsigned states, int limit,
 			     long long after, json_t **page, struct api_error *err)
 {
-	static const char sql[] =
-		"SELECT " JOB_COLUMNS "FROM jobs j JOIN users u ON u.id = j.user_id"
-		" WHERE (?1 = 0 OR j.user_id = ?1) AND (?2 = 0 OR j.id < ?2)"
-		" AND (?3 = 0 OR (?3 & CASE j.state WHEN 'queued' THEN 1 WHEN 'running' THEN 2"
-		" WHEN 'succeeded' THEN 4 WHEN 'failed' THEN 8 ELSE 16 END) != 0)"
-		" ORDER BY j.id DESC LIMIT ?4";
+	*page = NULL;
 	struct conn *c = store_reader(s, err);
 	if (!c)
 		return API_INTERNAL;
-	sqlite3_stmt *st = conn_stmt(c, sql);
-	if (!st) {
-		enum api_code rc = db_fail(c, err, "listing jobs");
-		store_reader_done(s, c);
-		return rc;
-	}
-	sqlite3_bind_int64(st, 1, who->role == ROLE_ADMIN ? 0 : who->user_id);
-	sqlite3_bind_int64(st, 2, after);
-	sqlite3_bind_int(st, 3, (int)states);
-	sqlite3_bind_int(st, 4, limit + 1);
+	conn_exec(c, "BEGIN"); /* the cursors of one listing read one snapshot */
+	struct list_cursor cur[JOB_STATE_COUNT];
+	int count = 0;
+	enum api_code rc = API_OK;
+	if (list_open(c, who, states, limit, after, cur, &count) != 0)
+		rc = db_fail(c, err, "listing jobs");
 	json_t *jobs = json_array();
 	long long last = 0;
-	int n = 0, more = 0;
-	while (sqlite3_step(st) == SQLITE_ROW) {
+	int n = 0, more = 0, best;
+	while (rc == API_OK && (best = list_newest(cur, count)) >= 0) {
 		if (n == limit) {
 			more = 1;
 			break;
 		}
-		json_array_append_new(jobs, job_from_row(st));
-		last = sqlite3_column_int64(st, 0);
+		json_array_append_new(jobs, job_from_row(cur[best].st));
+		last = sqlite3_column_int64(cur[best].st, 0);
 		n++;
+		cur[best].row = sqlite3_step(cur[best].st) == SQLITE_ROW;
 	}
-	sqlite3_reset(st);
+	struct list_stats cost = { .requests = 1 };
+	for (int i = 0; i < count; i++) {
+		sqlite3_reset(cur[i].st);
+		list_cost(&cost, cur[i].st);
+	}
 	store_reader_done(s, c);
+	pthread_mutex_lock(&s->lock);
+	s->list.requests += cost.requests;
+	s->list.vm_steps += cost.vm_steps;
+	s->list.fullscan_steps += cost.fullscan_steps;
+	s->list.sorts += cost.sorts;
+	pthread_mutex_unlock(&s->lock);
+	if (rc != API_OK) {
+		json_decref(jobs);
+		return rc;
+	}
 	*page = json_pack("{s:o, s:o}", "jobs", jobs, "next_after", more ? json_integer(last) : json_null());
 	return API_OK;
+}
+
+void store_list_stats(struct store *s, struct list_stats *out)
+{
+	pthread_mutex_lock(&s->lock);
+	*out = s->list;
+	pthread_mutex_unlock(&s->lock);
 }
 
 enum api_code store_job_counts(struct store *s, long long counts[JOB_STATE_COUNT], struct api_error *err)
@@ -371,7 +509,7 @@ enum api_code store_job_counts(struct store *s, long long counts[JOB_STATE_COUNT
 		return API_INTERNAL;
 	for (int i = 0; i < JOB_STATE_COUNT; i++)
 		counts[i] = 0;
-	sqlite3_stmt *st = conn_stmt(c, "SELECT state, count(*) FROM jobs GROUP BY state");
+	sqlite3_stmt *st = conn_stmt(c, "SELECT state, jobs FROM job_counts");
 	enum api_code rc = st ? API_OK : db_fail(c, err, "counting jobs");
 	while (st && sqlite3_step(st) == SQLITE_ROW) {
 		enum job_state js;
@@ -380,6 +518,24 @@ enum api_code store_job_counts(struct store *s, long long counts[JOB_STATE_COUNT
 	}
 	if (st)
 		sqlite3_reset(st);
+	store_reader_done(s, c);
+	return rc;
+}
+
+int store_job_exists(struct store *s, long long id)
+{
+	struct api_error err = { 0 };
+	struct conn *c = store_reader(s, &err);
+	if (!c)
+		return -1;
+	sqlite3_stmt *st = conn_stmt(c, "SELECT 1 FROM jobs WHERE id = ?1");
+	int rc = -1;
+	if (st) {
+		sqlite3_bind_int64(st, 1, id);
+		int step = sqlite3_step(st);
+		rc = step == SQLITE_ROW ? 1 : step == SQLITE_DONE ? 0 : -1;
+		sqlite3_reset(st);
+	}
 	store_reader_done(s, c);
 	return rc;
 }

@@ -1,6 +1,6 @@
 /*
  * store_worker.c - jobs as workers see them (store.h): the fair-share claim, heartbeats, log
- * chunks, the file index, finish, and the reaper's expiry of leases (docs/service.md §2).
+ * chunks with the cap per attempt and the reads of them, the file index (docs/service.md §2).
  *
  * Fencing: every worker write runs lease_live() inside the writer's transaction, so the check and
  * the write are atomic with respect to claims, expiries and other finishes; a write from an
@@ -17,6 +17,7 @@
 #include <errno.h>
 #include <fcntl.h>
 #include <libgen.h>
+#include <limits.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -245,7 +246,28 @@ enum api_code store_heartbeat(struct store *s, const struct principal *who, long
 	return rc;
 }
 
-/* ---- logs ---- */
+/* ---- logs ----
+ *
+ * The cap (--max-log-bytes, cap below): an attempt keeps its first H = cap / 2 bytes and its last
+ * T = cap - H bytes. log_attempts holds, per attempt, the end offset (where the next chunk goes)
+ * and the dropped range [dropped_from, dropped_to); the text stored is end - (to - from). When an
+ * append makes that exceed the cap, the chunks between the head and the tail are deleted in the
+ * same write with one range DELETE on the primary key (job_id, attempt, offset). The rule is
+ * chunk-granular: the head is the chunks that end at or before H (dropped_from is the offset of
+ * the chunk holding byte H), the tail the chunks from the one holding byte end - T on
+ * (dropped_to is its offset). So the head is at most H bytes, the tail less than T plus one
+ * chunk, and the text stored at most the cap plus one chunk (LOG_CHUNK_MAX; poro-worker sends
+ * whole lines of at most 256 KiB). Offsets stay absolute, so a chunk at an offset below the end,
+ * dropped or not, is accepted again without change, as before. */
+
+#define LOG_CHUNK_MAX (1LL << 20)   /* bytes of one appended chunk */
+
+static const char SQL_LOG_ATTEMPT[] =
+	"SELECT end_offset, dropped_from, dropped_to FROM log_attempts WHERE job_id = ?1 AND attempt = ?2";
+/* The offset of the chunk holding byte ?3 (the last chunk starting at or before it). */
+static const char SQL_CHUNK_AT[] =
+	"SELECT offset FROM log_chunks WHERE job_id = ?1 AND attempt = ?2 AND offset <= ?3"
+	" ORDER BY offset DESC LIMIT 1";
 
 struct log_op {
 	const struct principal *who;
@@ -255,64 +277,152 @@ struct log_op {
 	size_t size;
 };
 
+struct log_range {
+	long long end, from, to;   /* end offset and dropped range of an attempt */
+};
+
+static enum api_code log_range_read(struct conn *c, long long id, int attempt, struct log_range *r,
+				    struct api_error *err)
+{
+	sqlite3_stmt *st = conn_stmt(c, SQL_LOG_ATTEMPT);
+	if (!st)
+		return db_fail(c, err, "reading a log");
+	sqlite3_bind_int64(st, 1, id);
+	sqlite3_bind_int(st, 2, attempt);
+	*r = (struct log_range){ 0, 0, 0 };
+	int rc = sqlite3_step(st);
+	if (rc == SQLITE_ROW)
+		*r = (struct log_range){ sqlite3_column_int64(st, 0), sqlite3_column_int64(st, 1),
+					 sqlite3_column_int64(st, 2) };
+	sqlite3_reset(st);
+	return rc == SQLITE_ROW || rc == SQLITE_DONE ? API_OK : db_fail(c, err, "reading a log");
+}
+
+static enum api_code chunk_at(struct conn *c, long long id, int attempt, long long byte, long long *offset,
+			      struct api_error *err)
+{
+	sqlite3_stmt *st = conn_stmt(c, SQL_CHUNK_AT);
+	if (!st)
+		return db_fail(c, err, "finding a log chunk");
+	sqlite3_bind_int64(st, 1, id);
+	sqlite3_bind_int(st, 2, attempt);
+	sqlite3_bind_int64(st, 3, byte);
+	*offset = sqlite3_step(st) == SQLITE_ROW ? sqlite3_column_int64(st, 0) : 0;
+	sqlite3_reset(st);
+	return API_OK;
+}
+
+/* Drops the chunks between head and tail once the stored text exceeds the cap; *freed gets the
+ * bytes deleted. Called after the chunk ending at r->end was inserted. */
+static enum api_code log_trim(struct store *s, struct conn *c, long long id, int attempt, struct log_range *r,
+			      long long *freed, struct api_error *err)
+{
+	long long cap = s->cfg->max_log_bytes, head = cap / 2, tail = cap - head;
+	*freed = 0;
+	if (cap <= 0 || r->end - (r->to - r->from) <= cap)
+		return API_OK;
+	long long from = r->from, to;
+	enum api_code rc = API_OK;
+	if (r->to == r->from)   /* the first drop of this attempt fixes where the head ends */
+		rc = chunk_at(c, id, attempt, head, &from, err);
+	/* end - tail lies past the old dropped range (the stored text exceeds head + tail), so the
+	 * chunk holding it is present */
+	if (rc == API_OK)
+		rc = chunk_at(c, id, attempt, r->end - tail, &to, err);
+	long long start = r->to > r->from ? r->to : from;
+	if (rc != API_OK || to <= start)
+		return rc;
+	sqlite3_stmt *st = conn_stmt(c, "DELETE FROM log_chunks WHERE job_id = ?1 AND attempt = ?2"
+					" AND offset >= ?3 AND offset < ?4");
+	if (!st)
+		return db_fail(c, err, "preparing a log trim");
+	sqlite3_bind_int64(st, 1, id);
+	sqlite3_bind_int(st, 2, attempt);
+	sqlite3_bind_int64(st, 3, start);
+	sqlite3_bind_int64(st, 4, to);
+	if ((rc = step_done(c, st, err, "dropping log chunks")) != API_OK)
+		return rc;
+	*freed = to - start;   /* the chunks in [start, to) were contiguous */
+	r->from = from;
+	r->to = to;
+	return API_OK;
+}
+
 static enum api_code log_run(struct store *s, struct conn *c, void *arg, struct api_error *err)
 {
 	struct log_op *op = arg;
 	enum api_code rc = lease_live(c, op->who, op->id, op->attempt, NULL, NULL, err);
 	if (rc != API_OK)
 		return rc;
-	sqlite3_stmt *st = conn_stmt(c, "SELECT offset + length(text) FROM log_chunks WHERE job_id = ?1 AND attempt = ?2"
-					" ORDER BY offset DESC LIMIT 1");
-	if (!st)
-		return db_fail(c, err, "reading a log");
-	sqlite3_bind_int64(st, 1, op->id);
-	sqlite3_bind_int(st, 2, op->attempt);
-	op->next = sqlite3_step(st) == SQLITE_ROW ? sqlite3_column_int64(st, 0) : 0;
-	sqlite3_reset(st);
+	struct log_range r;
+	if ((rc = log_range_read(c, op->id, op->attempt, &r, err)) != API_OK)
+		return rc;
+	op->next = r.end;
 	if (op->offset < op->next || op->size == 0)
-		return API_OK; /* already stored: accepted again without change */
+		return API_OK; /* already stored, or dropped: accepted again without change */
 	if (op->offset > op->next) {
 		err->expected_offset = op->next;
 		return api_fail(err, API_LOG_GAP, "/offset", "log chunk at offset %lld leaves a gap: expected %lld",
 				op->offset, op->next);
 	}
-	st = conn_stmt(c, "INSERT INTO log_chunks (job_id, attempt, offset, text) VALUES (?1, ?2, ?3, ?4)");
+	sqlite3_stmt *st = conn_stmt(c, "INSERT INTO log_chunks (job_id, attempt, offset, text) VALUES (?1, ?2, ?3, ?4)");
 	if (!st)
 		return db_fail(c, err, "preparing a log chunk");
 	sqlite3_bind_int64(st, 1, op->id);
 	sqlite3_bind_int(st, 2, op->attempt);
 	sqlite3_bind_int64(st, 3, op->offset);
 	sqlite3_bind_blob64(st, 4, op->text, op->size, SQLITE_STATIC);
-	rc = step_done(c, st, err, "storing a log chunk");
-	op->next = op->offset + (long long)op->size;
+	if ((rc = step_done(c, st, err, "storing a log chunk")) != API_OK)
+		return rc;
+	r.end = op->offset + (long long)op->size;
+	long long freed = 0;
+	if ((rc = log_trim(s, c, op->id, op->attempt, &r, &freed, err)) != API_OK)
+		return rc;
+	st = conn_stmt(c, "INSERT INTO log_attempts (job_id, attempt, end_offset, dropped_from, dropped_to)"
+			  " VALUES (?1, ?2, ?3, ?4, ?5) ON CONFLICT (job_id, attempt) DO UPDATE SET"
+			  " end_offset = excluded.end_offset, dropped_from = excluded.dropped_from,"
+			  " dropped_to = excluded.dropped_to");
+	if (!st)
+		return db_fail(c, err, "preparing a log record");
+	sqlite3_bind_int64(st, 1, op->id);
+	sqlite3_bind_int(st, 2, op->attempt);
+	sqlite3_bind_int64(st, 3, r.end);
+	sqlite3_bind_int64(st, 4, r.from);
+	sqlite3_bind_int64(st, 5, r.to);
+	if ((rc = step_done(c, st, err, "recording a log's end")) != API_OK ||
+	    (rc = stored_bytes_add(c, op->id, (long long)op->size - freed, err)) != API_OK)
+		return rc;
+	op->next = r.end;
 	store_after_commit(s, WAKE_LOG_READERS);
-	return rc;
+	return API_OK;
 }
 
 enum api_code store_log_append(struct store *s, const struct principal *who, long long id, int attempt,
 			       long long offset, const char *text, size_t size, long long *next_offset,
 			       struct api_error *err)
 {
+	*next_offset = 0;
+	if ((long long)size > LOG_CHUNK_MAX)
+		return api_fail(err, API_TOO_LARGE, "/text", "log chunk of %zu bytes exceeds the limit of %lld bytes",
+				size, LOG_CHUNK_MAX);
 	struct log_op op = { .who = who, .id = id, .attempt = attempt, .offset = offset, .text = text, .size = size };
 	enum api_code rc = store_write(s, log_run, &op, err);
 	*next_offset = op.next;
 	return rc;
 }
 
-enum api_code store_log_read(struct store *s, long long id, int *attempt, long long offset, char **text,
-			     size_t *size, int *live, struct api_error *err)
+/* The attempt asked for (< 0: the current one), whether it is live, and its range; NOT_FOUND for
+ * a missing job. Runs inside the caller's read transaction. */
+static enum api_code log_state(struct conn *c, long long id, int *attempt, int *live, struct log_range *r,
+			       struct api_error *err)
 {
-	*text = NULL;
-	*size = 0;
-	struct conn *c = store_reader(s, err);
-	if (!c)
-		return API_INTERNAL;
-	conn_exec(c, "BEGIN");
-	enum api_code rc = API_OK;
 	sqlite3_stmt *st = conn_stmt(c, "SELECT attempt, state FROM jobs WHERE id = ?1");
-	if (!st || (sqlite3_bind_int64(st, 1, id), sqlite3_step(st)) != SQLITE_ROW) {
-		rc = st ? api_fail(err, API_NOT_FOUND, "", "no job %lld", id) : db_fail(c, err, "reading a job");
-		goto done;
+	if (!st)
+		return db_fail(c, err, "reading a job");
+	sqlite3_bind_int64(st, 1, id);
+	if (sqlite3_step(st) != SQLITE_ROW) {
+		sqlite3_reset(st);
+		return api_fail(err, API_NOT_FOUND, "", "no job %lld", id);
 	}
 	int current = sqlite3_column_int(st, 0);
 	*live = strcmp(col_text(st, 1), "running") == 0;
@@ -320,43 +430,100 @@ enum api_code store_log_read(struct store *s, long long id, int *attempt, long l
 	if (*attempt < 0)
 		*attempt = current;
 	*live = *live && *attempt == current;
-	st = conn_stmt(c, "SELECT offset, text FROM log_chunks WHERE job_id = ?1 AND attempt = ?2"
-			  " AND offset + length(text) > ?3 ORDER BY offset");
-	if (!st) {
+	return log_range_read(c, id, *attempt, r, err);
+}
+
+enum api_code store_log_info(struct store *s, long long id, int attempt, struct log_info *info,
+			     struct api_error *err)
+{
+	memset(info, 0, sizeof *info);
+	struct conn *c = store_reader(s, err);
+	if (!c)
+		return API_INTERNAL;
+	conn_exec(c, "BEGIN");
+	struct log_range r;
+	enum api_code rc = log_state(c, id, &attempt, &info->live, &r, err);
+	store_reader_done(s, c);
+	info->attempt = attempt;
+	info->end = r.end;
+	info->dropped_from = r.from;
+	info->dropped_to = r.to;
+	return rc;
+}
+
+/* Appends blob[skip..n) to b, growing it; -1 when out of memory. */
+static int block_append(struct log_block *b, const char *blob, size_t n, size_t skip)
+{
+	if (b->size + n - skip > b->cap) {
+		size_t cap = b->size + n - skip;
+		char *grown = realloc(b->text, cap);
+		if (!grown)
+			return -1;
+		b->text = grown;
+		b->cap = cap;
+	}
+	memcpy(b->text + b->size, blob + skip, n - skip);
+	b->size += n - skip;
+	return 0;
+}
+
+enum api_code store_log_read(struct store *s, long long id, int attempt, long long offset, long long until,
+			     size_t max, struct log_block *b, struct api_error *err)
+{
+	b->size = 0;
+	b->at = offset;
+	b->live = 0;
+	struct conn *c = store_reader(s, err);
+	if (!c)
+		return API_INTERNAL;
+	conn_exec(c, "BEGIN"); /* one snapshot for the attempt's state and its chunks */
+	struct log_range r;
+	enum api_code rc = log_state(c, id, &attempt, &b->live, &r, err);
+	b->end = r.end;
+	/* From the chunk holding byte offset on; a chunk that ends at or before offset (the last of
+	 * the head, when offset fell into the dropped range) is skipped. */
+	sqlite3_stmt *st = rc != API_OK ? NULL : conn_stmt(c,
+		"SELECT offset, text FROM log_chunks WHERE job_id = ?1 AND attempt = ?2"
+		" AND offset >= coalesce((SELECT offset FROM log_chunks WHERE job_id = ?1 AND attempt = ?2"
+		" AND offset <= ?3 ORDER BY offset DESC LIMIT 1), 0) AND offset < ?4 ORDER BY offset");
+	if (rc == API_OK && !st)
 		rc = db_fail(c, err, "reading a log");
-		goto done;
+	if (st) {
+		sqlite3_bind_int64(st, 1, id);
+		sqlite3_bind_int(st, 2, attempt);
+		sqlite3_bind_int64(st, 3, offset);
+		sqlite3_bind_int64(st, 4, until >= 0 ? until : LLONG_MAX);
 	}
-	sqlite3_bind_int64(st, 1, id);
-	sqlite3_bind_int(st, 2, *attempt);
-	sqlite3_bind_int64(st, 3, offset);
-	size_t cap = 0;
-	while (sqlite3_step(st) == SQLITE_ROW) {
+	long long next = -1;   /* offset the next chunk must have to continue the text */
+	while (st && sqlite3_step(st) == SQLITE_ROW) {
 		long long at = sqlite3_column_int64(st, 0);
-		const char *blob = sqlite3_column_blob(st, 1);
-		size_t n = (size_t)sqlite3_column_bytes(st, 1), skip = at < offset ? (size_t)(offset - at) : 0;
-		if (*size + n - skip + 1 > cap) {
-			cap = 2 * (*size + n + 1);
-			char *grown = realloc(*text, cap);
-			if (!grown) {
-				rc = api_fail(err, API_INTERNAL, "", "out of memory");
-				break;
-			}
-			*text = grown;
+		size_t n = (size_t)sqlite3_column_bytes(st, 1);
+		if (at + (long long)n <= offset)
+			continue;
+		if (next >= 0 && (at != next || b->size + n > max))
+			break; /* the dropped range, or enough for this block */
+		if (next < 0)
+			b->at = at > offset ? at : offset;
+		if (block_append(b, sqlite3_column_blob(st, 1), n, (size_t)(b->at > at ? b->at - at : 0)) != 0) {
+			rc = api_fail(err, API_INTERNAL, "", "out of memory");
+			break;
 		}
-		memcpy(*text + *size, blob + skip, n - skip);
-		*size += n - skip;
+		next = at + (long long)n;
+		if (b->size >= max)
+			break;
 	}
-	sqlite3_reset(st);
-done:
 	if (st)
 		sqlite3_reset(st);
 	store_reader_done(s, c);
-	if (rc != API_OK) {
-		free(*text);
-		*text = NULL;
-		*size = 0;
-	}
+	if (rc != API_OK)
+		b->size = 0;
 	return rc;
+}
+
+void log_block_release(struct log_block *b)
+{
+	free(b->text);
+	memset(b, 0, sizeof *b);
 }
 
 /* ---- files ---- */
@@ -405,8 +572,19 @@ static enum api_code file_run(struct store *s, struct conn *c, void *arg, struct
 	enum api_code rc = lease_live(c, op->who, op->id, op->attempt, NULL, NULL, err);
 	if (rc != API_OK)
 		return rc;
-	sqlite3_stmt *st = conn_stmt(c, "INSERT OR REPLACE INTO files (job_id, attempt, name, size, sha256, created_at)"
-					" VALUES (?1, ?2, ?3, ?4, ?5, ?6)");
+	/* a new version of the same name and attempt replaces the old file: only the difference counts */
+	sqlite3_stmt *st = conn_stmt(c, "SELECT size FROM files WHERE job_id = ?1 AND name = ?2 AND attempt = ?3");
+	if (!st)
+		return db_fail(c, err, "reading the file index");
+	sqlite3_bind_int64(st, 1, op->id);
+	sqlite3_bind_text(st, 2, op->name, -1, SQLITE_STATIC);
+	sqlite3_bind_int(st, 3, op->attempt);
+	long long replaced = sqlite3_step(st) == SQLITE_ROW ? sqlite3_column_int64(st, 0) : 0;
+	sqlite3_reset(st);
+	if ((rc = stored_bytes_add(c, op->id, op->size - replaced, err)) != API_OK)
+		return rc;
+	st = conn_stmt(c, "INSERT OR REPLACE INTO files (job_id, attempt, name, size, sha256, created_at)"
+			  " VALUES (?1, ?2, ?3, ?4, ?5, ?6)");
 	if (!st)
 		return db_fail(c, err, "preparing a file index row");
 	sqlite3_bind_int64(st, 1, op->id);

@@ -147,10 +147,10 @@ code=$(submit "$alice" "$tmp/big.json" -H 'Transfer-Encoding: chunked')
 expect_error bad_oversize_chunked_413 413 body_too_large "" "$code"
 code=$(svc_req GET /v1/nothing "$alice")
 expect_error bad_unknown_route_404 404 not_found "" "$code"
-code=$(svc_req DELETE "/v1/jobs/$id1" "$alice")
+code=$(svc_req PATCH "/v1/jobs/$id1" "$alice")
 allow=$(svc_header Allow)
 expect_error bad_wrong_method_405 405 method_not_allowed "" "$code"
-[ "$allow" = "GET, HEAD" ]
+[ "$allow" = "GET, HEAD, DELETE" ]
 check bad_wrong_method_allow_header $? "Allow '$allow'"
 code=$(svc_req GET /v1/jobs "")
 expect_error bad_missing_token_401 401 unauthorized Authorization "$code"
