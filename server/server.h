@@ -36,6 +36,7 @@ struct server_config {
 	int max_backoff_seconds;      /* cap of the retry backoff min(2^(attempt-1), cap) */
 	int group_commit_max;         /* most write requests in one transaction */
 	char access_log[SERVER_STATE_MAX]; /* one line per answered request, or "" for none */
+	int min_free_mb;              /* /healthz is degraded below this much free space on the state file system, MiB */
 };
 
 /*      code                        HTTP  name on the wire */
