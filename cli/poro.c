@@ -9,6 +9,8 @@
  *   poro cancel ID
  *   poro rm ID                  (a finished job and everything stored for it)
  *   poro fetch ID [--out DIR]
+ *   poro token ls
+ *   poro token revoke ID
  *
  * The server URL and token come from PORO_SERVER and PORO_TOKEN, else ~/.config/poro/config.
  * A submission always carries an Idempotency-Key (a random one unless --idempotency-key), so a
@@ -18,6 +20,7 @@
  */
 #define _GNU_SOURCE
 #include <errno.h>
+#include <limits.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -51,6 +54,7 @@ static int usage(void)
 		"       poro cancel ID\n"
 		"       poro rm ID\n"
 		"       poro fetch ID [--out DIR]\n"
+		"       poro token ls | poro token revoke ID\n"
 		"server and token from PORO_SERVER and PORO_TOKEN, else ~/.config/poro/config\n");
 	return 2;
 }
@@ -621,6 +625,60 @@ static int cmd_fetch(int argc, char **argv)
 	return rc;
 }
 
+/* ---- tokens ------------------------------------------------------------------------------------ */
+
+static void print_token_row(const json_t *t)
+{
+	const char *label = json_get_str(t, "label", NULL), *revoked = json_get_str(t, "revoked_at", NULL);
+	const char *used = json_get_str(t, "last_used_at", NULL);
+	printf("%-6lld %-12.12s %-7s %-11s %-24s %-24s %-24s %s\n", json_get_int(t, "id", -1),
+	       json_get_str(t, "user", "-"), json_get_str(t, "role", "-"), json_get_str(t, "fingerprint", "-"),
+	       json_get_str(t, "created_at", "-"), used ? used : "-", revoked ? revoked : "-", label ? label : "-");
+}
+
+/* poro token ls: every page of GET /v1/tokens (the caller's own tokens; an admin sees all). */
+static int token_ls(void)
+{
+	printf("%-6s %-12s %-7s %-11s %-24s %-24s %-24s %s\n", "ID", "USER", "ROLE", "FINGERPRINT", "CREATED",
+	       "LAST USED", "REVOKED", "LABEL");
+	long long after = 0;
+	do {
+		char path[96] = "/v1/tokens?limit=1000";
+		if (after)
+			snprintf(path, sizeof path, "/v1/tokens?limit=1000&after=%lld", after);
+		struct http_response r;
+		if (call("GET", path, NULL, NULL, &r) != 200)
+			return fail(&r);
+		size_t i;
+		json_t *t;
+		json_array_foreach(json_object_get(r.json, "tokens"), i, t)
+			print_token_row(t);
+		after = json_get_int(r.json, "next_after", 0);
+		http_response_release(&r);
+	} while (after > 0);
+	return 0;
+}
+
+static int cmd_token(int argc, char **argv)
+{
+	if (argc == 1 && !strcmp(argv[0], "ls"))
+		return token_ls();
+	long long id;
+	if (argc != 2 || strcmp(argv[0], "revoke"))
+		return usage();
+	if (parse_int("token revoke", argv[1], 1, LLONG_MAX, &id) < 0)
+		return 2;
+	char path[64];
+	snprintf(path, sizeof path, "/v1/tokens/%lld", id);
+	struct http_response r;
+	if (call("DELETE", path, NULL, NULL, &r) != 200)
+		return fail(&r);
+	printf("token %lld of '%s' (fingerprint %s) revoked at %s\n", id, json_get_str(r.json, "user", "?"),
+	       json_get_str(r.json, "fingerprint", "?"), json_get_str(r.json, "revoked_at", "?"));
+	http_response_release(&r);
+	return 0;
+}
+
 int main(int argc, char **argv)
 {
 	if (argc < 2)
@@ -660,6 +718,8 @@ int main(int argc, char **argv)
 		rc = cmd_rm(n, rest);
 	else if (!strcmp(cmd, "fetch"))
 		rc = cmd_fetch(n, rest);
+	else if (!strcmp(cmd, "token"))
+		rc = cmd_token(n, rest);
 	else
 		rc = usage();
 	http_client_destroy(&http);

@@ -47,6 +47,8 @@ void admin_healthz(struct request *r);
 void admin_metrics(struct request *r);
 void admin_users_create(struct request *r);
 void admin_tokens_create(struct request *r);
+void admin_tokens_list(struct request *r);
+void admin_tokens_revoke(struct request *r);
 
 /* ---- request-body helpers (api_json.c) ---- */
 /* The body as a JSON object; NULL after replying 400 invalid_json (with jansson's line and column),

@@ -83,6 +83,8 @@ static const struct route ROUTES[] = {
 	{ "GET", "/metrics", ROLE_WORKER | ROLE_ADMIN, BODY_SMALL, admin_metrics, 0, 0, 0, 0 },
 	{ "POST", "/v1/users", ROLE_ADMIN, BODY_SMALL, admin_users_create, 0, 0, 0, 0 },
 	{ "POST", "/v1/tokens", ROLE_ADMIN, BODY_SMALL, admin_tokens_create, 0, 0, 0, 0 },
+	{ "GET", "/v1/tokens", USER_ROLES, BODY_SMALL, admin_tokens_list, 0, 0, 0, 0 },
+	{ "DELETE", "/v1/tokens/{id}", USER_ROLES, BODY_SMALL, admin_tokens_revoke, 0, 0, 0, 0 },
 };
 #define ROUTE_COUNT (sizeof ROUTES / sizeof ROUTES[0])
 

@@ -1,9 +1,14 @@
 /*
  * main.c - the poro-server program: configuration from a file and flags (flags win), the
- * `token create` set-up subcommand, start-up (state directory, database, HTTP, reaper, the URL
- * written atomically to STATE/server.url) and orderly shutdown on SIGTERM or SIGINT: stop
- * accepting, let in-flight requests finish (their writes commit), end long-polls and followed
- * logs, stop the writer, close the database, exit 0.
+ * `token create|list|revoke` subcommands (token_cli.c), start-up (state directory locked and made
+ * private, database, HTTP, reaper, the URL written atomically to STATE/server.url) and orderly
+ * shutdown on SIGTERM or SIGINT: stop accepting, let in-flight requests finish (their writes
+ * commit), end long-polls and followed logs, stop the writer, close the database, exit 0.
+ *
+ * The process runs under umask 077, so everything it creates (database, WAL, results, the URL
+ * file) is its owner's alone; state_dir_restrict() takes away what older runs left open. SIGXFSZ
+ * is ignored: a write past a file-size limit (RLIMIT_FSIZE) then fails with EFBIG, which SQLite
+ * and the upload path report as an error answer, instead of killing the server.
  *
  * Every option is one row of OPTIONS: the flag name, which is also the key in the config file
  * ("name = value" lines, '#' comments), the field it sets, its default and its help text.
@@ -12,9 +17,10 @@
 #include "http.h"
 #include "metrics.h"
 #include "reaper.h"
+#include "state_dir.h"
 #include "store.h"
+#include "token_cli.h"
 
-#include "digest.h"
 #include "fs.h"
 
 #include <errno.h>
@@ -71,6 +77,7 @@ static const struct option_def OPTIONS[] = {
 	TEXT_OPT("access-log", access_log, "append 'METHOD ROUTE STATUS MILLISECONDS' per request to FILE (default none)"),
 	LONG_OPT("max-log-bytes", max_log_bytes, 65536, 1LL << 50, "log text kept per attempt: its first and last half (default 67108864)"),
 	LONG_OPT("user-max-stored-bytes", user_max_stored_bytes, 0, 1LL << 60, "default per-user cap on stored bytes (cases, logs, files), 0 = unlimited (default 2147483648)"),
+	INT_OPT("min-free-mb", min_free_mb, 0, 1 << 30, "/healthz is degraded below this free space on the state file system, MiB (default 64)"),
 };
 #define OPTION_COUNT (sizeof OPTIONS / sizeof OPTIONS[0])
 
@@ -83,12 +90,15 @@ static const struct server_config CONFIG_DEFAULTS = {
 	.user_max_running = 0, .max_backoff_seconds = 60, .group_commit_max = 1024,
 	.max_job_threads = 64,
 	.max_log_bytes = 64LL << 20, .user_max_stored_bytes = 2LL << 30,
+	.min_free_mb = 64,
 };
 
 static void usage(FILE *out)
 {
 	fprintf(out, "usage: poro-server [--config FILE] [--OPTION VALUE ...]\n"
-		     "       poro-server token create --state DIR --user NAME --role user|worker|admin\n\n"
+		     "       poro-server token create --state DIR --user NAME --role user|worker|admin [--label TEXT]\n"
+		     "       poro-server token list --state DIR\n"
+		     "       poro-server token revoke --state DIR --id N\n\n"
 		     "The HTTP job server of PoroMPM (docs/service.md). Every option may also be a line\n"
 		     "'name = value' in the config file; flags win over the file.\n\n"
 		     "options:\n  --config FILE  read options from FILE\n");
@@ -199,68 +209,30 @@ static int parse_args(struct server_config *cfg, int argc, char **argv)
 	return 0;
 }
 
-static int open_store(struct server_config *cfg, struct server *srv, struct store **store)
+/* Makes the state directory, takes its lock (kept in *lock_fd for the life of the process), takes
+ * group and other permissions away from what an older run left, and opens the database. */
+static int open_state(struct server *srv, int *lock_fd)
 {
-	char path[SERVER_PATH_MAX + 16];
-	if (fs_make_dirs(cfg->state) != 0) {
-		fprintf(stderr, "poro-server: cannot create state directory '%s': %s\n", cfg->state, strerror(errno));
+	const char *state = srv->cfg.state;
+	char msg[SERVER_MESSAGE_MAX], files[SERVER_PATH_MAX];
+	if (fs_make_dirs(state) != 0) {
+		fprintf(stderr, "poro-server: cannot create state directory '%s': %s\n", state, strerror(errno));
 		return -1;
 	}
-	snprintf(path, sizeof path, "%s/poro.db", cfg->state);
-	struct api_error err = { 0 };
-	if (store_open(store, path, cfg, srv, &err) != API_OK) {
-		fprintf(stderr, "poro-server: %s\n", err.message);
+	if ((*lock_fd = state_dir_lock(state, msg, sizeof msg)) < 0) {
+		fprintf(stderr, "poro-server: %s\n", msg);
+		return -1;
+	}
+	state_dir_restrict(state);
+	/* /healthz creates its probe file here, so files/ exists before the first upload */
+	snprintf(files, sizeof files, "%s/files", state);
+	if (fs_make_dirs(files) != 0)
+		fprintf(stderr, "poro-server: cannot create '%s': %s\n", files, strerror(errno));
+	if (state_dir_open_store(&srv->cfg, srv, &srv->store, msg, sizeof msg) != 0) {
+		fprintf(stderr, "poro-server: %s\n", msg);
 		return -1;
 	}
 	return 0;
-}
-
-static int token_create(int argc, char **argv)
-{
-	struct server_config cfg = CONFIG_DEFAULTS;
-	const char *user = NULL, *role_text = NULL;
-	for (int i = 3; i < argc; i += 2) {
-		const char *v = i + 1 < argc ? argv[i + 1] : NULL;
-		if (!v) {
-			fprintf(stderr, "poro-server: token create: '%s' needs a value\n", argv[i]);
-			return 2;
-		}
-		if (strcmp(argv[i], "--state") == 0 && strlen(v) < sizeof cfg.state)
-			snprintf(cfg.state, sizeof cfg.state, "%s", v);
-		else if (strcmp(argv[i], "--user") == 0)
-			user = v;
-		else if (strcmp(argv[i], "--role") == 0)
-			role_text = v;
-		else {
-			fprintf(stderr, "poro-server: token create: unknown argument '%s'\n", argv[i]);
-			return 2;
-		}
-	}
-	enum role role;
-	if (!user || !user[0] || strlen(user) > SERVER_NAME_MAX || !role_text || role_parse(role_text, &role) != 0) {
-		fprintf(stderr, "poro-server: token create needs --user NAME and --role user|worker|admin\n");
-		return 2;
-	}
-	struct store *store = NULL;
-	if (open_store(&cfg, NULL, &store) != 0)
-		return 1;
-	char token[DIGEST_TOKEN_SIZE], hash[DIGEST_HEX_SIZE];
-	struct api_error err = { 0 };
-	int rc = 0;
-	if (digest_new_token(token) != 0) {
-		fprintf(stderr, "poro-server: no randomness available for a token\n");
-		rc = 1;
-	} else {
-		digest_hex(token, strlen(token), hash);
-		if (store_token_add(store, user, (int)role, hash, &err) != API_OK) {
-			fprintf(stderr, "poro-server: cannot create a token for '%s': %s\n", user, err.message);
-			rc = 1;
-		}
-	}
-	store_close(&store);
-	if (rc == 0)
-		printf("%s\n", token);
-	return rc;
 }
 
 /* Writes the URL to STATE/server.url through a temporary file and a rename. */
@@ -269,7 +241,7 @@ static int write_url(const char *state, const char *url)
 	char tmp[SERVER_PATH_MAX + 32], path[SERVER_PATH_MAX + 32];
 	snprintf(tmp, sizeof tmp, "%s/server.url.tmp", state);
 	snprintf(path, sizeof path, "%s/server.url", state);
-	int fd = open(tmp, O_WRONLY | O_CREAT | O_TRUNC, 0644);
+	int fd = open(tmp, O_WRONLY | O_CREAT | O_TRUNC, 0600);
 	if (fd < 0)
 		return -1;
 	size_t n = strlen(url);
@@ -318,8 +290,12 @@ static int serve(struct server *srv)
 	/* Blocked in every thread created from here on; main waits for them with sigwait. */
 	pthread_sigmask(SIG_BLOCK, &signals, NULL);
 	signal(SIGPIPE, SIG_IGN);
-	if (open_store(&srv->cfg, srv, &srv->store) != 0)
+	int lock_fd = -1;
+	if (open_state(srv, &lock_fd) != 0) {
+		if (lock_fd >= 0)
+			close(lock_fd);
 		return 1;
+	}
 	store_set_commit_observer(srv->store, metrics_observe_commit, srv->metrics);
 	sweep_files(srv);
 	char url[512], msg[SERVER_MESSAGE_MAX];
@@ -327,6 +303,7 @@ static int serve(struct server *srv)
 	if (!daemon) {
 		fprintf(stderr, "poro-server: %s\n", msg);
 		store_close(&srv->store);
+		close(lock_fd);
 		return 1;
 	}
 	if (write_url(srv->cfg.state, url) != 0)
@@ -346,14 +323,17 @@ static int serve(struct server *srv)
 	reaper_stop(&reaper);
 	http_stop(daemon);          /* waits for in-flight requests, whose writes commit first */
 	store_close(&srv->store);   /* drains the writer, checkpoints, closes */
+	close(lock_fd);             /* another server may take the state directory from here on */
 	fprintf(stderr, "poro-server: stopped on signal %d\n", sig);
 	return 0;
 }
 
 int main(int argc, char **argv)
 {
-	if (argc >= 3 && strcmp(argv[1], "token") == 0 && strcmp(argv[2], "create") == 0)
-		return token_create(argc, argv);
+	umask(077);                 /* see the top of this file and state_dir.c */
+	signal(SIGXFSZ, SIG_IGN);
+	if (argc >= 2 && strcmp(argv[1], "token") == 0)
+		return token_command(argc, argv, &CONFIG_DEFAULTS);
 	static struct server srv;
 	if (parse_args(&srv.cfg, argc, argv) != 0)
 		return 2;

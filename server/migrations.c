@@ -121,6 +121,29 @@ static const char *const MIGRATIONS[] = {
 	"        UNION ALL SELECT 'failed' UNION ALL SELECT 'cancelled') s;"
 	"CREATE TABLE counters (name TEXT PRIMARY KEY, value INTEGER NOT NULL) WITHOUT ROWID;"
 	"INSERT INTO counters (name, value) VALUES ('job_id', coalesce((SELECT max(id) FROM jobs), 0));",
+
+	/* 3: tokens get an integer id (what listing shows and revoking names; the token itself is
+	 * never shown again), last_used_at (updated at most once a minute per token), revoked_at (a
+	 * revoked token is refused on its next request) and an optional label; the SHA-256 stays the
+	 * lookup key (now a unique index). The one-row table health is what /healthz rewrites to prove
+	 * that a write still commits; writes counts those rewrites. */
+	"CREATE TABLE tokens_v2 ("
+	"  id INTEGER PRIMARY KEY,"
+	"  sha256 TEXT NOT NULL UNIQUE,"
+	"  user_id INTEGER NOT NULL REFERENCES users(id),"
+	"  label TEXT,"
+	"  created_at INTEGER NOT NULL,"
+	"  last_used_at INTEGER,"
+	"  revoked_at INTEGER);"
+	"INSERT INTO tokens_v2 (sha256, user_id, created_at)"
+	"  SELECT sha256, user_id, created_at FROM tokens ORDER BY created_at, sha256;"
+	"DROP TABLE tokens;"
+	"ALTER TABLE tokens_v2 RENAME TO tokens;"
+	"CREATE INDEX tokens_user ON tokens (user_id, id);"
+	"CREATE TABLE health ("
+	"  id INTEGER PRIMARY KEY CHECK (id = 1),"
+	"  checked_at INTEGER NOT NULL,"
+	"  writes INTEGER NOT NULL);",
 };
 
 #define MIGRATION_COUNT ((int)(sizeof MIGRATIONS / sizeof MIGRATIONS[0]))

@@ -48,6 +48,7 @@ struct server_config {
 	char access_log[SERVER_STATE_MAX]; /* one line per answered request, or "" for none */
 	long long max_log_bytes;      /* log text kept per attempt: its first and last half, bytes */
 	long long user_max_stored_bytes; /* default per-user cap on stored bytes; 0 = unlimited */
+	int min_free_mb;              /* /healthz is degraded below this much free space on the state file system, MiB */
 };
 
 /*      code                        HTTP  name on the wire */

@@ -30,15 +30,37 @@ void store_close(struct store **s);
 /* 0 when a read of the database works (for /healthz). */
 int store_ping(struct store *s);
 
+/* 0 when a write commits: the one row of table health is rewritten through the writer thread
+ * (store_health.c, for /healthz); API_INTERNAL with the database's reason otherwise. */
+enum api_code store_health_write(struct store *s, struct api_error *err);
+
 /* ---- users and tokens (store_users.c) ---- */
-/* The principal owning a token, by the token's SHA-256 hex. API_UNAUTHORIZED when unknown. */
+/* A token's last_used_at is rewritten at most this often, so authentication costs a write once a
+ * minute per token rather than once a request. */
+#define TOKEN_TOUCH_INTERVAL_MS 60000
+/* Hex digits of a token's SHA-256 shown as its fingerprint: enough to tell tokens apart, far too
+ * few to look one up. */
+#define TOKEN_FINGERPRINT_HEX 8
+/* The principal owning a token, by the token's SHA-256 hex. API_UNAUTHORIZED when unknown or
+ * revoked (read on every request: a revocation holds from the next request on). */
 enum api_code store_auth(struct store *s, const char *token_sha256, struct principal *who, struct api_error *err);
 /* Creates a user; max_queued / max_running < 0 mean "the server default". API_ALREADY_EXISTS. */
 enum api_code store_user_create(struct store *s, const char *name, enum role role, int max_queued,
 				int max_running, json_t **user, struct api_error *err);
-/* Stores a token hash for a user; with create_role > 0 the user is created first if missing. */
+/* Stores a token hash for a user, with an optional label (NULL for none); with create_role > 0
+ * the user is created first if missing. *token (may be NULL) gets the token as listed. */
 enum api_code store_token_add(struct store *s, const char *user, int create_role, const char *token_sha256,
-			      struct api_error *err);
+			      const char *label, json_t **token, struct api_error *err);
+/* Tokens newest first, as {"tokens": [{"id", "user", "role", "label", "created_at", "last_used_at",
+ * "revoked_at", "fingerprint"}], "next_after": ID or null}: every token for an admin or for who ==
+ * NULL (the offline `poro-server token list`), else the principal's own. after = 0 for the first
+ * page. Neither the token nor its whole hash is ever part of the answer. */
+enum api_code store_token_list(struct store *s, const struct principal *who, int limit, long long after,
+			       json_t **page, struct api_error *err);
+/* Revokes token id (admin, who == NULL, or the token's own user; another user's token is
+ * API_NOT_FOUND, as a missing one); revoking a revoked token changes nothing. *token gets it. */
+enum api_code store_token_revoke(struct store *s, const struct principal *who, long long id, json_t **token,
+				 struct api_error *err);
 
 /* ---- jobs, user side (store_jobs.c) ---- */
 struct job_submit {

@@ -21,7 +21,13 @@ if [ "$mode" = test ]; then
 	# every poro-server the service tests start logs its requests here; the coverage check reads it
 	export SVC_ROUTES_LOG="$PWD/$build/service-routes.log"
 	: > "$SVC_ROUTES_LOG"
+	# every token the service tests create is recorded here, and the logs they leave are kept
+	# there; the token-leak check then greps every log for every token (tests/service/lib.sh)
+	export SVC_TOKENS_LOG="$PWD/$build/service-tokens.txt" SVC_KEEP_LOGS="$PWD/$build/service-logs"
+	(umask 077 && : > "$SVC_TOKENS_LOG")
+	rm -rf "$SVC_KEEP_LOGS"
 	programs+=("bash tests/service/route_coverage.sh $build $SVC_ROUTES_LOG")
+	programs+=("bash tests/service/token_leak_check.sh $build")
 else
 	for t in "$build"/tests/verify/*_test; do [ -x "$t" ] && programs+=("$t"); done
 	export PORO_VERIFY_LONG=1   # verification programs add their long runs (strip_footing_test)

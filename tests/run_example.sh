@@ -8,7 +8,8 @@
 #
 # Tokens are created once and kept in var/tokens/ (user.token, worker.token; mode 600), so later
 # runs reuse them; `export PORO_SERVER=... PORO_TOKEN=$(cat var/tokens/user.token)` lets the poro
-# CLI and curl talk to the same service. PORO_LISTEN overrides the address (HOST:PORT).
+# CLI and curl talk to the same service. The worker reads its token from its file (--token-file),
+# so no token appears in the process list. PORO_LISTEN overrides the address (HOST:PORT).
 #   tests/run_example.sh BUILD_DIR
 set -u
 build=${1:-build}
@@ -17,6 +18,7 @@ listen=${PORO_LISTEN:-127.0.0.1:8080}
 state=var
 mkdir -p "$state/tokens" runs || exit 4
 chmod 700 "$state/tokens"
+chmod 600 "$state"/tokens/*.token 2>/dev/null   # poro-worker refuses a token file others may read
 
 server_pid=""
 worker_pid=""
@@ -38,7 +40,7 @@ token() { # ROLE: the saved token of that role, created on first use
 	cat "$file"
 }
 
-user_token=$(token user) && worker_token=$(token worker) || { echo "run_example: cannot create tokens in $state" >&2; exit 4; }
+user_token=$(token user) && token worker > /dev/null || { echo "run_example: cannot create tokens in $state" >&2; exit 4; }
 
 rm -f "$state/server.url"
 "$build/poro-server" --listen "$listen" --state "$state" > "$state/server.log" 2>&1 &
@@ -54,7 +56,7 @@ for i in $(seq 100); do
 	sleep 0.1
 done
 url=$(cat "$state/server.url")
-"$build/poro-worker" --server "$url" --token "$worker_token" --work "$state/work" --solver "$build/poro-solve" \
+"$build/poro-worker" --server "$url" --token-file "$state/tokens/worker.token" --work "$state/work" --solver "$build/poro-solve" \
 	> "$state/worker.log" 2>&1 &
 worker_pid=$!
 

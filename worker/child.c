@@ -2,6 +2,15 @@
  * child.c - fork/exec of the solver with its limits, see child.h. The pipe is created with
  * O_CLOEXEC so that a solver started by another slot never inherits this one's write end (which
  * would keep this job's pipe open after its solver has exited).
+ *
+ * The solver dies with its worker: right after fork the child asks the kernel for SIGKILL when
+ * its parent goes (prctl PR_SET_PDEATHSIG), then checks that the parent has not already gone
+ * between fork and prctl (getppid() no longer the pid recorded before fork), and exits if so.
+ * Linux sends the death signal when the *thread* that forked exits, not only the process: here
+ * that is the slot thread, which runs the job from fork to reaping (job_run) and only then claims
+ * the next one, so the signal can come only after the solver has ended, or with the worker's
+ * death, which is the point. A worker killed with -9 thus takes its solvers with it; the lease
+ * then expires and the job resumes elsewhere from its last uploaded checkpoint.
  */
 #define _GNU_SOURCE
 #include "child.h"
@@ -12,9 +21,13 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/prctl.h>
 #include <sys/resource.h>
 #include <sys/wait.h>
 #include <unistd.h>
+
+/* Exit status of a child whose worker died before it could exec (nobody reads it). */
+#define CHILD_ORPHANED 126
 
 extern char **environ;
 
@@ -26,10 +39,17 @@ extern char **environ;
  * (docs/performance.md, "Threads"). */
 static char wait_policy[] = "OMP_WAIT_POLICY=passive";
 
-/* environ without OMP_NUM_THREADS, plus OMP_NUM_THREADS=threads, plus wait_policy when environ has
- * no OMP_WAIT_POLICY; NULL when out of memory. The strings are environ's own, env_omp and
- * wait_policy. */
-static char **child_environment(int threads, char *env_omp, size_t size)
+/* Variables the solver never gets: the worker's token (also dropped wherever else it appears). */
+static int withheld(const char *entry, const char *secret)
+{
+	return !strncmp(entry, "OMP_NUM_THREADS=", 16) || !strncmp(entry, "PORO_TOKEN=", 11) ||
+	       (secret && secret[0] && strstr(entry, secret));
+}
+
+/* environ without OMP_NUM_THREADS and what withheld() names, plus OMP_NUM_THREADS=threads, plus
+ * wait_policy when environ has no OMP_WAIT_POLICY; NULL when out of memory. The strings are
+ * environ's own, env_omp and wait_policy. */
+static char **child_environment(int threads, const char *secret, char *env_omp, size_t size)
 {
 	size_t n = 0;
 	while (environ[n])
@@ -40,7 +60,7 @@ static char **child_environment(int threads, char *env_omp, size_t size)
 	size_t k = 0;
 	int has_wait_policy = 0;
 	for (size_t i = 0; i < n; i++) {
-		if (!strncmp(environ[i], "OMP_NUM_THREADS=", 16))
+		if (withheld(environ[i], secret))
 			continue;
 		has_wait_policy |= !strncmp(environ[i], "OMP_WAIT_POLICY=", 16);
 		env[k++] = environ[i];
@@ -62,7 +82,7 @@ int child_start(const struct child_spec *spec, pid_t *pid, int *out_fd, char *er
 		snprintf(err, err_size, "cannot create a pipe: %s", strerror(errno));
 		return -1;
 	}
-	char **env = child_environment(spec->threads, omp, sizeof omp);
+	char **env = child_environment(spec->threads, spec->secret, omp, sizeof omp);
 	if (!env) {
 		close(fds[0]);
 		close(fds[1]);
@@ -72,6 +92,8 @@ int child_start(const struct child_spec *spec, pid_t *pid, int *out_fd, char *er
 	struct rlimit as = {RLIM_INFINITY, RLIM_INFINITY};
 	if (spec->memory_limit_mb > 0)
 		as.rlim_cur = as.rlim_max = (rlim_t)spec->memory_limit_mb << 20;
+	size_t note_len = spec->note ? strlen(spec->note) : 0;
+	pid_t parent = getpid();
 	pid_t p = fork();
 	if (p < 0) {
 		snprintf(err, err_size, "cannot fork: %s", strerror(errno));
@@ -81,6 +103,9 @@ int child_start(const struct child_spec *spec, pid_t *pid, int *out_fd, char *er
 		return -1;
 	}
 	if (p == 0) {
+		prctl(PR_SET_PDEATHSIG, SIGKILL);
+		if (getppid() != parent)
+			_exit(CHILD_ORPHANED); /* the worker died before prctl: nobody would supervise the solver */
 		sigset_t none;
 		sigemptyset(&none);
 		sigprocmask(SIG_SETMASK, &none, NULL);
@@ -91,6 +116,10 @@ int child_start(const struct child_spec *spec, pid_t *pid, int *out_fd, char *er
 			dup2(in, 0);
 		dup2(fds[1], 1);
 		dup2(fds[1], 2);
+		if (note_len) {
+			ssize_t w = write(1, spec->note, note_len);
+			(void)w;
+		}
 		if (spec->memory_limit_mb > 0)
 			setrlimit(RLIMIT_AS, &as);
 		if (chdir(spec->dir) == 0)

@@ -713,7 +713,16 @@ static int start_solver(struct job *j, int resume, char *err, size_t err_size)
 		argv[n++] = wall;
 	}
 	argv[n] = NULL;
-	struct child_spec spec = {j->dir, argv, worker_opt.memory_limit_mb, j->threads};
+	/* a job asking more threads than this slot offers runs with the slot's share, and says so */
+	char note[256] = "";
+	int threads = j->threads > worker_opt.threads ? worker_opt.threads : j->threads;
+	if (threads < j->threads)
+		snprintf(note, sizeof note, "running with %d thread%s of the %d asked: this worker gives each of its %d "
+			 "slot%s %d thread%s (--threads %d)\n", threads, threads == 1 ? "" : "s", j->threads,
+			 worker_opt.slots, worker_opt.slots == 1 ? "" : "s", threads, threads == 1 ? "" : "s",
+			 worker_opt.thread_budget);
+	struct child_spec spec = { .dir = j->dir, .argv = argv, .memory_limit_mb = worker_opt.memory_limit_mb,
+				   .threads = threads, .note = note, .secret = worker_opt.token };
 	int fd;
 	if (child_start(&spec, &j->pid, &fd, err, err_size) < 0)
 		return -1;

@@ -1,12 +1,25 @@
 /*
  * main.c - poro-worker's command line, signals and slot threads.
  *
- *   poro-worker --server URL --token TOKEN [--slots N (1)] [--work DIR (./var/work)]
- *               [--solver PATH] [--memory-limit-mb N] [--checkpoint-wall SECONDS (60)]
- *               [--lease-renew SECONDS] [--name NAME] [--keep-work yes|no (no)]
+ *   poro-worker --server URL --token-file FILE [--slots N (1)] [--threads N (online CPUs)]
+ *               [--work DIR (./var/work)] [--solver PATH] [--memory-limit-mb N]
+ *               [--checkpoint-wall SECONDS (60)] [--lease-renew SECONDS] [--name NAME]
+ *               [--keep-work yes|no (no)]
  *
- * The token may come from PORO_TOKEN and the URL from PORO_SERVER (or the config file read by the
- * CLI). The solver defaults to poro-solve next to this binary, else the first on PATH. SIGTERM or
+ * The token comes from --token-file, else PORO_TOKEN, else the config file read by the CLI; the
+ * URL from --server, else PORO_SERVER. --token TOKEN still works but puts the token in every
+ * user's process list: the worker says so and overwrites its copy in argv at once, which shortens
+ * the exposure but cannot undo it. A token file readable by group or others is refused, as ssh
+ * refuses such a private key: a file anyone can read leaks the token as surely as argv does, and
+ * refusing says how to fix it where a warning would scroll by. PORO_TOKEN is removed from the
+ * environment once read, so no child (the solver, the probes of its version) inherits it.
+ *
+ * --threads is the worker's thread budget: each slot offers max(1, N / slots) threads in its
+ * claims and runs a solver with at most that many (job.c). --memory-limit-mb defaults to
+ * WORKER_MEMORY_SHARE of physical memory divided by the slots; 0 (asked for) means no limit. Both
+ * appear in the worker's start line.
+ *
+ * The solver defaults to poro-solve next to this binary, else the first on PATH. SIGTERM or
  * SIGINT drains: no new claims, running jobs finish, exit 0. A second one stops the solvers (their
  * jobs are reported as infrastructure failures and re-queued) and the worker exits. The signals
  * are blocked in every thread and taken synchronously here with sigtimedwait, so no handler runs
@@ -71,13 +84,64 @@ void worker_sleep(double seconds, int wake_on_drain)
 		usleep(20000);
 }
 
+#define TOKEN_FILE_MAX 4096      /* bytes read of a token file: a token and a newline */
+#define THREADS_MAX 4096
+#define MEMORY_DEFAULT (-1L)     /* memory_limit_mb before the default is computed */
+
 static int usage(void)
 {
-	fprintf(stderr, "usage: poro-worker --server URL --token TOKEN [--slots N] [--work DIR] [--solver PATH]\n"
-			"                   [--memory-limit-mb N] [--checkpoint-wall SECONDS] [--lease-renew SECONDS]\n"
-			"                   [--name NAME] [--keep-work yes|no]\n");
+	fprintf(stderr, "usage: poro-worker --server URL --token-file FILE [--slots N] [--threads N] [--work DIR]\n"
+			"                   [--solver PATH] [--memory-limit-mb N] [--checkpoint-wall SECONDS]\n"
+			"                   [--lease-renew SECONDS] [--name NAME] [--keep-work yes|no]\n"
+			"the token may also come from PORO_TOKEN, the URL from PORO_SERVER\n");
 	return 2;
 }
+
+/* Reads the token from the first line of path into out; refuses a file others may read. */
+static int read_token_file(const char *path, char *out, size_t size)
+{
+	FILE *f = fopen(path, "r");
+	struct stat st;
+	if (!f || fstat(fileno(f), &st) != 0) {
+		fprintf(stderr, "poro-worker: cannot read token file '%s': %s\n", path, strerror(errno));
+		if (f)
+			fclose(f);
+		return -1;
+	}
+	if (!S_ISREG(st.st_mode) || (st.st_mode & 077)) {
+		fprintf(stderr, "poro-worker: token file '%s' is %s (mode %04o): make it private to its owner "
+				"(chmod 600 '%s')\n", path, S_ISREG(st.st_mode) ? "readable by group or others" : "not a regular file",
+			(unsigned)(st.st_mode & 07777), path);
+		fclose(f);
+		return -1;
+	}
+	char line[TOKEN_FILE_MAX];
+	int ok = fgets(line, sizeof line, f) != NULL;
+	fclose(f);
+	line[ok ? strcspn(line, "\r\n") : 0] = '\0';
+	if (!line[0] || strlen(line) >= size) {
+		fprintf(stderr, "poro-worker: token file '%s' has no token on its first line\n", path);
+		return -1;
+	}
+	snprintf(out, size, "%s", line);
+	return 0;
+}
+
+/* The default memory limit of one solver, MB: WORKER_MEMORY_SHARE of physical memory over the
+ * slots, or 0 in an AddressSanitizer build, whose shadow memory reserves terabytes of address
+ * space that no RLIMIT_AS could allow (the sanitizer tests run such a solver). */
+static long default_memory_limit_mb(long physical_mb)
+{
+#ifdef __SANITIZE_ADDRESS__
+	return 0;
+#else
+	long share = (long)(WORKER_MEMORY_SHARE * (double)physical_mb / worker_opt.slots);
+	return share > 0 ? share : 0;
+#endif
+}
+
+static long physical_mb;          /* physical memory, MB, when the memory limit is the default */
+static int memory_defaulted;      /* 1: memory_limit_mb is the default, not --memory-limit-mb */
 
 static int parse_long(const char *s, long lo, long hi, long *out)
 {
@@ -166,21 +230,30 @@ static void probe_solver(void)
 
 static int parse_flags(int argc, char **argv)
 {
-	const char *solver = NULL, *work = "var/work", *name = NULL;
-	long v;
+	const char *solver = NULL, *work = "var/work", *name = NULL, *token_file = NULL;
+	long v, budget = 0;
 	worker_opt.slots = 1;
 	worker_opt.checkpoint_wall = 60;
+	worker_opt.memory_limit_mb = MEMORY_DEFAULT;
 	for (int i = 1; i < argc; i++) {
-		const char *a = argv[i], *val = i + 1 < argc ? argv[i + 1] : NULL;
+		const char *a = argv[i];
+		char *val = i + 1 < argc ? argv[i + 1] : NULL;
 		if (!val)
 			return usage();
 		i++;
-		if (!strcmp(a, "--server"))
+		if (!strcmp(a, "--server")) {
 			snprintf(worker_opt.server, sizeof worker_opt.server, "%s", val);
-		else if (!strcmp(a, "--token"))
+		} else if (!strcmp(a, "--token")) {
 			snprintf(worker_opt.token, sizeof worker_opt.token, "%s", val);
+			memset(val, 'x', strlen(val)); /* out of /proc/PID/cmdline from now on */
+			fprintf(stderr, "poro-worker: warning: --token shows the token to every user of this machine "
+					"in the process list; use --token-file FILE or PORO_TOKEN\n");
+		} else if (!strcmp(a, "--token-file"))
+			token_file = val;
 		else if (!strcmp(a, "--slots") && !parse_long(val, 1, 1024, &v))
 			worker_opt.slots = (int)v;
+		else if (!strcmp(a, "--threads") && !parse_long(val, 1, THREADS_MAX, &v))
+			budget = v;
 		else if (!strcmp(a, "--work"))
 			work = val;
 		else if (!strcmp(a, "--solver"))
@@ -200,6 +273,12 @@ static int parse_flags(int argc, char **argv)
 			return usage();
 		}
 	}
+	if (token_file && worker_opt.token[0]) {
+		fprintf(stderr, "poro-worker: give either --token or --token-file, not both\n");
+		return 2;
+	}
+	if (token_file && read_token_file(token_file, worker_opt.token, sizeof worker_opt.token) != 0)
+		return 2;
 	char err[1200] = "";
 	struct client_config cfg = {0};
 	snprintf(cfg.server, sizeof cfg.server, "%s", worker_opt.server);
@@ -210,6 +289,7 @@ static int parse_flags(int argc, char **argv)
 	}
 	snprintf(worker_opt.server, sizeof worker_opt.server, "%s", cfg.server);
 	snprintf(worker_opt.token, sizeof worker_opt.token, "%s", cfg.token);
+	unsetenv("PORO_TOKEN"); /* read: no child inherits it (child.c also strips it) */
 	if (!worker_opt.server[0] || !worker_opt.token[0]) {
 		fprintf(stderr, "poro-worker: no server URL or token (--server/--token, PORO_SERVER/PORO_TOKEN)\n");
 		return 2;
@@ -226,8 +306,34 @@ static int parse_flags(int argc, char **argv)
 	else
 		snprintf(worker_opt.name, sizeof worker_opt.name, "%.200s:%d", worker_opt.host, (int)getpid());
 	long cpus = sysconf(_SC_NPROCESSORS_ONLN);
-	worker_opt.threads = cpus > 0 ? (int)cpus : 1;
+	worker_opt.thread_budget = budget > 0 ? (int)budget : cpus > 0 ? (int)cpus : 1;
+	worker_opt.threads = worker_opt.thread_budget / worker_opt.slots;
+	if (worker_opt.threads < 1)
+		worker_opt.threads = 1;
+	if (worker_opt.memory_limit_mb == MEMORY_DEFAULT) {
+		long pages = sysconf(_SC_PHYS_PAGES), page = sysconf(_SC_PAGE_SIZE);
+		physical_mb = pages > 0 && page > 0 ? (long)((double)pages * (double)page / (1 << 20)) : 0;
+		worker_opt.memory_limit_mb = default_memory_limit_mb(physical_mb);
+		memory_defaulted = 1;
+	}
 	return 0;
+}
+
+/* "memory limit N MB per solver (how it was chosen)" for the start line. */
+static void describe_memory(char *out, size_t size)
+{
+	if (memory_defaulted) {
+		if (worker_opt.memory_limit_mb > 0)
+			snprintf(out, size, "memory limit %ld MB per solver (default: %.0f%% of %ld MB physical / %d slot%s)",
+				 worker_opt.memory_limit_mb, 100 * WORKER_MEMORY_SHARE, physical_mb, worker_opt.slots,
+				 worker_opt.slots == 1 ? "" : "s");
+		else
+			snprintf(out, size, "no memory limit (default of this build: AddressSanitizer needs the address space)");
+	} else if (worker_opt.memory_limit_mb > 0) {
+		snprintf(out, size, "memory limit %ld MB per solver (--memory-limit-mb)", worker_opt.memory_limit_mb);
+	} else {
+		snprintf(out, size, "no memory limit (--memory-limit-mb 0)");
+	}
 }
 
 static void *slot_thread(void *arg)
@@ -257,9 +363,12 @@ int main(int argc, char **argv)
 	sigaddset(&set, SIGTERM);
 	sigaddset(&set, SIGINT);
 	pthread_sigmask(SIG_BLOCK, &set, NULL);
-	worker_say("%s serving %s with %d slot%s, solver %s (%s), work %s", worker_opt.name, worker_opt.server,
-		   worker_opt.slots, worker_opt.slots == 1 ? "" : "s", worker_opt.solver, worker_opt.solver_version,
-		   worker_opt.work);
+	char memory[256];
+	describe_memory(memory, sizeof memory);
+	worker_say("%s serving %s with %d slot%s of %d thread%s (--threads %d), %s, solver %s (%s), work %s",
+		   worker_opt.name, worker_opt.server, worker_opt.slots, worker_opt.slots == 1 ? "" : "s",
+		   worker_opt.threads, worker_opt.threads == 1 ? "" : "s", worker_opt.thread_budget, memory,
+		   worker_opt.solver, worker_opt.solver_version, worker_opt.work);
 	pthread_t *threads = calloc((size_t)worker_opt.slots, sizeof *threads);
 	int started = 0;
 	for (int i = 0; threads && i < worker_opt.slots; i++) {

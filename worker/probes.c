@@ -72,7 +72,8 @@ int probes_start(struct probes_run *p, const char *dir, const char *result, long
 	snprintf(attempt_text, sizeof attempt_text, "%d", attempt);
 	char *argv[] = { worker_opt.solver, "probes", (char *)result, "--job", job, "--attempt", attempt_text, "--out",
 			 PROBES_OUT, NULL };
-	struct child_spec spec = { dir, argv, worker_opt.memory_limit_mb, 1 };
+	struct child_spec spec = { .dir = dir, .argv = argv, .memory_limit_mb = worker_opt.memory_limit_mb, .threads = 1,
+				   .secret = worker_opt.token };
 	int fd;
 	if (child_start(&spec, &p->pid, &fd, err, err_size) < 0) {
 		p->pid = 0;

@@ -33,20 +33,29 @@
 #define WORKER_FINISH_PATIENCE 300.0
 #define WORKER_STOP_PATIENCE 10.0
 
+/* Default memory limit of a solver: this fraction of physical memory, divided among the slots.
+ * The rest is left to the worker, the page cache and whatever else the machine runs; a solver
+ * that needs more fails with a clear message instead of pushing the machine into swap or the
+ * kernel's OOM killer. */
+#define WORKER_MEMORY_SHARE 0.75
+
 struct worker_options {
 	char server[1024];       /* base URL */
 	char token[512];         /* worker token */
 	int slots;               /* jobs run at once */
 	char work[4096];         /* absolute directory holding job-<id>-<attempt>/ */
 	char solver[4096];       /* absolute path of poro-solve */
-	long memory_limit_mb;    /* RLIMIT_AS of a solver, 0: none */
+	long memory_limit_mb;    /* RLIMIT_AS of a solver, 0: none (default: WORKER_MEMORY_SHARE of
+				  * physical memory divided by the slots) */
 	long checkpoint_wall;    /* seconds of wall time between checkpoints given to the solver, 0: none */
 	const char *checkpoint_flag; /* the solver's option for it, NULL when the solver has none */
 	double lease_renew;      /* heartbeat interval override, seconds, 0: from the lease */
 	int keep_work;           /* 1: keep each job's directory after it ends (--keep-work yes) */
 	char name[256];          /* "host:pid" unless --name */
 	char host[256];
-	int threads;             /* hardware threads offered in claims */
+	int thread_budget;       /* --threads: hardware threads of the whole worker (default: online CPUs) */
+	int threads;             /* threads each slot offers in its claims and gives a solver at most:
+				  * max(1, thread_budget / slots) */
 	char solver_version[128];
 };
 

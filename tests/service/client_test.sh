@@ -25,6 +25,7 @@ pids=()
 cleanup() {
 	for p in "${pids[@]}" $(solver_pids); do kill -9 "$p" 2>/dev/null; done
 	wait 2>/dev/null
+	svc_keep_logs "$tmp"   # for the token-leak check
 	rm -rf "$tmp"
 }
 trap cleanup EXIT

@@ -13,6 +13,12 @@
 #
 # Several named instances may run at once; svc_use NAME makes one current. Everything started is
 # stopped and the temporary directory removed when the script exits.
+#
+# For the token-leak check (tests/service/token_leak_check.sh), tests/run.sh sets two variables:
+# with SVC_TOKENS_LOG set, every token svc_token creates (and every one a test passes to
+# svc_record_token) is appended to that file; with SVC_KEEP_LOGS set, the logs a script leaves in
+# its temporary directory (*.out, *.err, *.log: servers' stdout and stderr, workers' logs) are
+# copied into that directory before the temporary directory is removed.
 
 SVC_BUILD=build
 SVC_TMP=""
@@ -26,7 +32,29 @@ svc_cleanup() {
 	for name in "${!SVC_PIDS[@]}"; do
 		wait "${SVC_PIDS[$name]}" 2>/dev/null
 	done
-	[ -n "$SVC_TMP" ] && rm -rf "$SVC_TMP"
+	[ -n "$SVC_TMP" ] && svc_keep_logs "$SVC_TMP" && rm -rf "$SVC_TMP"
+}
+
+# svc_keep_logs DIR: with SVC_KEEP_LOGS set, copies the *.out, *.err and *.log files of DIR (and
+# of its subdirectories, one level down) into it, named SCRIPT-PATH with slashes as '-'. Always
+# succeeds: a log that cannot be kept must not fail the test.
+svc_keep_logs() {
+	[ -n "${SVC_KEEP_LOGS:-}" ] || return 0
+	local dir=$1 script f rel
+	script=$(basename "$0" .sh)
+	mkdir -p "$SVC_KEEP_LOGS" 2>/dev/null || return 0
+	while IFS= read -r f; do
+		rel=${f#"$dir"/}
+		cp "$f" "$SVC_KEEP_LOGS/$script-${rel//\//-}" 2>/dev/null
+	done < <(find "$dir" -maxdepth 2 -type f \( -name '*.out' -o -name '*.err' -o -name '*.log' \) 2>/dev/null)
+	return 0
+}
+
+# svc_record_token TOKEN: notes a token a test created (by svc_token, or through POST /v1/tokens)
+# in $SVC_TOKENS_LOG, when set, for the token-leak check.
+svc_record_token() {
+	[ -n "${SVC_TOKENS_LOG:-}" ] && [ -n "$1" ] && (umask 077 && printf '%s\n' "$1" >> "$SVC_TOKENS_LOG")
+	return 0
 }
 
 # svc_init BUILD_DIR: a temporary directory for this script and the cleanup trap.
@@ -86,18 +114,26 @@ svc_stop() {
 	unset "SVC_PIDS[$1]"
 }
 
-# svc_token NAME USER ROLE: creates (if needed) the user and prints a new token.
+# svc_token NAME USER ROLE: creates (if needed) the user and prints a new token (recorded, see above).
 svc_token() {
-	"$SVC_BUILD/poro-server" token create --state "${SVC_STATES[$1]}" --user "$2" --role "$3"
+	local token
+	token=$("$SVC_BUILD/poro-server" token create --state "${SVC_STATES[$1]}" --user "$2" --role "$3") || return
+	svc_record_token "$token"
+	printf '%s\n' "$token"
 }
 
 # svc_req METHOD PATH TOKEN [curl arguments...]: one request to the current instance; prints the
 # status code; the body goes to $SVC_BODY and the headers to $SVC_HEADERS. TOKEN "" sends none.
+# The Authorization header reaches curl through a file (-H @FILE), not its command line, so the
+# token is not in the process list while the request runs.
 svc_req() {
 	local method=$1 path=$2 token=$3
 	shift 3
-	local auth=()
-	[ -n "$token" ] && auth=(-H "Authorization: Bearer $token")
+	local auth=() header="$SVC_TMP/.auth-$BASHPID"
+	if [ -n "$token" ]; then
+		(umask 077 && printf 'Authorization: Bearer %s\n' "$token" > "$header")
+		auth=(-H "@$header")
+	fi
 	curl -s --path-as-is -X "$method" "${auth[@]}" -o "$SVC_BODY" -D "$SVC_HEADERS" \
 		-w '%{http_code}' "$@" "$SVC_URL$path"
 }
