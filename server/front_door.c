@@ -249,7 +249,7 @@ static enum door_class classify(struct front_door *d, const struct request_head 
 	digest_hex(h->bearer, h->bearer_len, hash);
 	struct principal who = { 0 };
 	struct api_error err = { 0 };
-	int worker = store_auth(d->srv->store, hash, &who, &err) == API_OK && who.role == ROLE_WORKER;
+	int worker = store_auth_peek(d->srv->store, hash, &who, &err) == API_OK && who.role == ROLE_WORKER;
 	return worker ? DOOR_WORKER : DOOR_USER;
 }
 

@@ -44,6 +44,10 @@ enum api_code store_health_write(struct store *s, struct api_error *err);
 /* The principal owning a token, by the token's SHA-256 hex. API_UNAUTHORIZED when unknown or
  * revoked (read on every request: a revocation holds from the next request on). */
 enum api_code store_auth(struct store *s, const char *token_sha256, struct principal *who, struct api_error *err);
+/* The same check with reads only (never a write, so it never waits on the disk): for the front
+ * door, which must not stall every connection behind one fsync. */
+enum api_code store_auth_peek(struct store *s, const char *token_sha256, struct principal *who,
+			      struct api_error *err);
 /* Creates a user; max_queued / max_running < 0 mean "the server default". API_ALREADY_EXISTS. */
 enum api_code store_user_create(struct store *s, const char *name, enum role role, int max_queued,
 				int max_running, json_t **user, struct api_error *err);

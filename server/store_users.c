@@ -62,7 +62,9 @@ static enum api_code token_touch_run(struct store *s, struct conn *c, void *arg,
 	return step_done(c, st, err, "recording a token's use");
 }
 
-enum api_code store_auth(struct store *s, const char *token_sha256, struct principal *who, struct api_error *err)
+/* The principal of a token; *touch gets the token's id when its last_used_at is due a rewrite. */
+static enum api_code auth_lookup(struct store *s, const char *token_sha256, struct principal *who,
+				 struct token_touch *touch_out, struct api_error *err)
 {
 	struct conn *c = store_reader(s, err);
 	if (!c)
@@ -90,11 +92,26 @@ enum api_code store_auth(struct store *s, const char *token_sha256, struct princ
 		sqlite3_reset(st);
 	}
 	store_reader_done(s, c);
-	if (touch.id > 0) {
+	*touch_out = touch;
+	return rc;
+}
+
+enum api_code store_auth(struct store *s, const char *token_sha256, struct principal *who, struct api_error *err)
+{
+	struct token_touch touch;
+	enum api_code rc = auth_lookup(s, token_sha256, who, &touch, err);
+	if (rc == API_OK && touch.id > 0) {
 		struct api_error ignored = { 0 };
 		store_write(s, token_touch_run, &touch, &ignored); /* best effort, see the top of this file */
 	}
 	return rc;
+}
+
+enum api_code store_auth_peek(struct store *s, const char *token_sha256, struct principal *who,
+			      struct api_error *err)
+{
+	struct token_touch touch;
+	return auth_lookup(s, token_sha256, who, &touch, err);
 }
 
 struct user_op {
