@@ -115,7 +115,7 @@ void admin_healthz(struct request *r)
 	size_t size = health.size + 1;
 	pthread_mutex_unlock(&health.lock);
 	if (!copy) {
-		reply_fail(r, API_UNAVAILABLE, "", "out of memory");
+		reply_fail(r, API_UNAVAILABLE, "", "out of memory: retry later");
 		return;
 	}
 	reply_header(r, "Cache-Control", "no-store");
@@ -127,7 +127,7 @@ void admin_metrics(struct request *r)
 	size_t size = 0;
 	char *text = metrics_render(r->srv->metrics, r->srv->store, &size);
 	if (!text) {
-		reply_fail(r, API_INTERNAL, "", "out of memory");
+		reply_fail(r, API_UNAVAILABLE, "", "out of memory: retry later");
 		return;
 	}
 	reply_text(r, 200, "text/plain; version=0.0.4; charset=utf-8", text, size);

@@ -12,8 +12,8 @@
  * probes.json is the one file whose content the server checks: it is served as the answer of GET
  * /v1/jobs/{id}/probes, so it must be one JSON object. json_scan checks it while it streams in, in
  * constant memory, within JSON_FILE_MAX_BYTES (or --max-upload-bytes when smaller), a nesting depth
- * and a token length; a file that fails is 422 invalid_json_file naming the byte, and is not
- * stored. The server never parses result files (docs/service.md §3, "Probes").
+ * and a token length; a file that fails is 422 invalid_json_file naming the line and column, and
+ * is not stored. The server never parses result files (docs/service.md §3, "Probes").
  *
  * Downloads (files_serve.c) send X-Checksum-Sha256, honour one byte range and check the copy on
  * disk against its index row.
@@ -115,7 +115,7 @@ void files_upload_begin(struct request *r)
 {
 	struct upload *u = calloc(1, sizeof *u);
 	if (!u) {
-		reply_fail(r, API_INTERNAL, "", "out of memory");
+		reply_fail(r, API_UNAVAILABLE, "", "out of memory: retry later");
 		return;
 	}
 	u->fd = -1;

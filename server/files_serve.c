@@ -233,7 +233,7 @@ static void serve_whole(struct request *r, int fd, const struct copy_key *k, con
 		if (!c || !(c->digest = digest_create())) {
 			free(c);
 			close(fd);
-			reply_fail(r, API_INTERNAL, "", "out of memory");
+			reply_fail(r, API_UNAVAILABLE, "", "out of memory: retry later");
 			return;
 		}
 		c->fd = fd;

@@ -71,7 +71,7 @@ static int check_case(struct request *r, const json_t *case_spec, struct case_sp
 {
 	struct poro_error *perr = calloc(1, sizeof *perr);
 	if (!perr) {
-		reply_fail(r, API_INTERNAL, "", "out of memory");
+		reply_fail(r, API_UNAVAILABLE, "", "no memory to check the case: retry later");
 		return -1;
 	}
 	enum poro_status st = case_load_json(case_spec, loaded, perr);

@@ -157,7 +157,7 @@ void logs_get(struct request *r)
 	}
 	struct log_reader *lr = calloc(1, sizeof *lr);
 	if (!lr) {
-		reply_fail(r, API_INTERNAL, "", "out of memory");
+		reply_fail(r, API_UNAVAILABLE, "", "out of memory: retry later");
 		return;
 	}
 	*lr = (struct log_reader){ .srv = r->srv, .id = r->id, .attempt = info.attempt, .pos = offset,

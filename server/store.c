@@ -250,7 +250,7 @@ struct conn *store_reader(struct store *s, struct api_error *err)
 		if (c)
 			api_fail(err, API_INTERNAL, "", "%s", msg);
 		else
-			api_fail(err, API_INTERNAL, "", "out of memory");
+			api_fail(err, API_UNAVAILABLE, "", "out of memory: retry later");
 		free(c);
 		return NULL;
 	}

@@ -505,7 +505,7 @@ enum api_code store_log_read(struct store *s, long long id, int attempt, long lo
 		if (next < 0)
 			b->at = at > offset ? at : offset;
 		if (block_append(b, sqlite3_column_blob(st, 1), n, (size_t)(b->at > at ? b->at - at : 0)) != 0) {
-			rc = api_fail(err, API_INTERNAL, "", "out of memory");
+			rc = api_fail(err, API_UNAVAILABLE, "", "out of memory: retry later");
 			break;
 		}
 		next = at + (long long)n;
