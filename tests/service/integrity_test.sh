@@ -9,7 +9,7 @@
 #   - probes come from a real worker: it runs `poro-solve probes` on each result.h5 it uploads and
 #     uploads probes.json, which GET probes serves byte for byte; a worker whose solver leaves a
 #     damaged result.h5 loses the probes (the extraction dies in its own process), not the job;
-#   - an uploaded probes.json that is not JSON is refused 422 invalid_json_file naming the byte;
+#   - an uploaded probes.json that is not JSON is refused 422 invalid_json_file naming where it fails;
 #   - a finish "succeeded" without a stored result.h5, or with a declared checksum that is not the
 #     stored one, is 409 artifact_missing and the job stays running;
 #   - a result.h5 the server refuses (a --max-upload-bytes below its size) fails the job with a
@@ -135,9 +135,9 @@ check probes_of_damaged_result_server_alive $? "GET probes answered $code; serve
 
 # probes.json is checked as JSON while it streams in
 printf '{"job": %s, "attempt": 1, "probes": {"p": {"unit": "Pa", "time": [0, 1], "value": [2.5,, 3]}}}' "$j1" > "$tmp/bad.json"
-at=$(python3 -c 'import sys; print(open(sys.argv[1]).read().index(",,") + 1)' "$tmp/bad.json")
+column=$(python3 -c 'import sys; print(open(sys.argv[1]).read().index(",,") + 2)' "$tmp/bad.json")
 code=$(put "$pool" "$cid" "$catt" probes.json "$tmp/bad.json")
-error_is "$code" 422 invalid_json_file && grep -q "at byte $at" "$SVC_BODY"
+error_is "$code" 422 invalid_json_file && grep -q "at line 1 column $column" "$SVC_BODY"
 check probes_json_not_json_refused_422 $? "status $code: $(head -c 300 "$SVC_BODY")"
 [ ! -e "$SVC_STATE/files/$j1/$catt/probes.json" ] && [ "$(svc_req GET "/v1/jobs/$j1/probes" "$alice")" = 404 ]
 check refused_probes_json_not_stored $? "stored: $(ls "$SVC_STATE/files/$j1/$catt")"
