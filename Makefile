@@ -4,6 +4,7 @@
 #   make verify  paper-size verification runs (long)
 #   make bench   speed figures (printed, never asserted)
 #   make test SAN=1   the same tests under AddressSanitizer + UBSan
+#   make test-san     the service's tests alone under AddressSanitizer + UBSan (docs/service.md §6)
 # Every public target first runs deploy/deps.sh, which returns at once when nothing is missing.
 
 CC      ?= cc
@@ -46,7 +47,7 @@ SERVER_LIBS = -lmicrohttpd -lsqlite3 -lm $(SVC_LIBS)
 SERVICE    = $(if $(SERVER_OBJ),$(BUILD)/poro-server) $(if $(WORKER_OBJ),$(BUILD)/poro-worker) \
 	     $(if $(CLIENT_OBJ),$(BUILD)/poro $(BUILD)/poro-load)
 
-.PHONY: all deps run test verify bench clean build-all format
+.PHONY: all deps run test test-san verify bench clean build-all build-service format
 .DEFAULT_GOAL := all
 
 deps:
@@ -64,6 +65,14 @@ run: deps
 test: deps
 	@$(MAKE) --no-print-directory build-all
 	@bash tests/run.sh $(BUILD) test
+
+# The service's binaries, poro-solve (the workers run it) and the tests of common/: what the
+# service tests need, without the solver's test programs.
+build-service: $(POROSOLVE) $(COMMON_TEST_BIN) $(SERVICE)
+
+test-san: deps
+	@$(MAKE) --no-print-directory SAN=1 build-service
+	@bash tests/run.sh build-san service
 
 verify: deps
 	@$(MAKE) --no-print-directory build-all

@@ -5,6 +5,9 @@
 #                                   are already at the papers' sizes, so `make test` includes them,
 #                                   except runs a program keeps for PORO_VERIFY_LONG=1, which this
 #                                   mode sets (strip_footing_test: finer grids, full load)
+#   tests/run.sh BUILD_DIR service  the service's tests alone: tests/common and tests/service, with
+#                                   the route-coverage and token-leak checks (make test-san runs
+#                                   them on the sanitizer build)
 # Each C test prints PASS/FAIL/XFAIL lines; INFO lines carry the measured figures. The full
 # output is kept in BUILD_DIR/test-output.txt.
 set -u
@@ -15,9 +18,14 @@ log="$build/test-output.txt"
 : > "$log"
 
 programs=()
-if [ "$mode" = test ]; then
-	for t in "$build"/tests/common/*_test "$build"/tests/solver/*_test "$build"/tests/verify/*_test; do [ -x "$t" ] && programs+=("$t"); done
-	for t in tests/cli/*_test.sh tests/service/*_test.sh; do [ -f "$t" ] && programs+=("bash $t $build"); done
+if [ "$mode" = test ] || [ "$mode" = service ]; then
+	if [ "$mode" = test ]; then
+		for t in "$build"/tests/common/*_test "$build"/tests/solver/*_test "$build"/tests/verify/*_test; do [ -x "$t" ] && programs+=("$t"); done
+		for t in tests/cli/*_test.sh; do [ -f "$t" ] && programs+=("bash $t $build"); done
+	else
+		for t in "$build"/tests/common/*_test; do [ -x "$t" ] && programs+=("$t"); done
+	fi
+	for t in tests/service/*_test.sh; do [ -f "$t" ] && programs+=("bash $t $build"); done
 	# every poro-server the service tests start logs its requests here; the coverage check reads it
 	export SVC_ROUTES_LOG="$PWD/$build/service-routes.log"
 	: > "$SVC_ROUTES_LOG"

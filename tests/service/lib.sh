@@ -162,6 +162,13 @@ check() {
 	if [ "$2" -eq 0 ]; then echo "PASS $1"; else echo "FAIL $1: $3"; fi
 }
 
+# svc_asan BINARY: status 0 when BINARY was built with AddressSanitizer (make test-san), whose
+# shadow memory reserves terabytes of address space: such a process cannot run under an address
+# space limit (RLIMIT_AS), so checks that need one are left out, saying so.
+svc_asan() {
+	ldd "$1" 2>/dev/null | grep -q libasan
+}
+
 # wait_for SECONDS COMMAND...: runs COMMAND every 0.1 s until it succeeds (status 0) or SECONDS
 # have passed (status 1). Waiting on the state itself, not a fixed sleep, keeps the tests quick on
 # an idle machine and correct on a loaded one. What COMMAND prints is dropped: a poll's misses are

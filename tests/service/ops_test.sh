@@ -295,7 +295,7 @@ check worker_start_line_states_threads $? "$(head -1 "$SVC_TMP/wa.log")"
 expected_mb=$(python3 -c 'import os; print(int(0.75 * (os.sysconf("SC_PHYS_PAGES") * os.sysconf("SC_PAGE_SIZE") / 2**20) / 2))')
 expected_limit=$(( expected_mb << 20 ))
 expected_line="memory limit $expected_mb MB per solver (default: 75% of [0-9]* MB physical / 2 slots)"
-if ldd "$build/poro-worker" 2>/dev/null | grep -q libasan; then
+if svc_asan "$build/poro-worker"; then
 	# an AddressSanitizer build (make test SAN=1) defaults to no limit: its shadow memory needs the address space
 	expected_limit=unlimited
 	expected_line="no memory limit (default of this build: AddressSanitizer"
