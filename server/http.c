@@ -14,7 +14,7 @@
  * accumulated (JSON routes: the limit enforced again while streaming chunked bodies, and the JSON
  * checked while it streams, common/json_scan.h; a body that breaks either is discarded to its end
  * and answered 413 or 400) or streamed to the route's upload callbacks, and finally the handler
- * runs (a submission after waiting for its turn, request_gate.h).
+ * runs (a submission's parsing and validation take their turn, request_gate.h).
  *
  * The URL is not unescaped by libmicrohttpd (UNESCAPE_CALLBACK is the identity): path elements
  * and query values are decoded here and in handlers, one element at a time, so an encoded slash
@@ -108,7 +108,7 @@ struct exchange {
 	int upload_failed;            /* upload_data replied: discard the rest */
 	int upload_started;
 	int token_counted;            /* the gate counts this request against token_hash */
-	int submission;               /* holds a submission's turn */
+	int submission;               /* holds a submission's turn (http_submission_enter) */
 	char token_hash[DIGEST_HEX_SIZE];
 	struct json_scan scan;        /* of a JSON body as it streams in */
 	int scan_failed;              /* the scan refused the body: discard the rest */
@@ -572,25 +572,26 @@ static int take_data(struct exchange *x, const char *data, size_t size)
 	return 0;
 }
 
-/* Runs the handler; a submission first waits for its turn among those being validated. */
-static void handle(struct exchange *x)
+int http_submission_enter(struct request *r)
 {
-	struct request *r = &x->req;
-	if (r->route->body == BODY_CASE) {
-		int running;
-		if (request_gate_submission_enter(x->http->gate, &running) != 0) {
-			reply_header(r, "Retry-After", "1");
-			reply_fail(r, API_UNAVAILABLE, "", "the server is validating %d submissions, its limit, and none "
-				   "ended within %d s: retry later", running, SUBMISSION_WAIT_SECONDS);
-			return;
-		}
-		x->submission = 1;
+	struct exchange *x = (struct exchange *)r; /* req is the exchange's first member */
+	int running;
+	if (request_gate_submission_enter(x->http->gate, &running) != 0) {
+		reply_header(r, "Retry-After", "1");
+		reply_fail(r, API_UNAVAILABLE, "", "the server is checking %d submissions, its limit, and none "
+			   "ended within %d s: retry later", running, SUBMISSION_WAIT_SECONDS);
+		return -1;
 	}
-	r->route->handle(r);
-	if (x->submission) {
+	x->submission = 1;
+	return 0;
+}
+
+void http_submission_leave(struct request *r)
+{
+	struct exchange *x = (struct exchange *)r;
+	if (x->submission)
 		request_gate_submission_leave(x->http->gate);
-		x->submission = 0;
-	}
+	x->submission = 0;
 }
 
 static enum MHD_Result on_request(void *cls, struct MHD_Connection *connection, const char *url, const char *method,
@@ -642,7 +643,7 @@ static enum MHD_Result on_request(void *cls, struct MHD_Connection *connection, 
 		if (r->route->upload_end)
 			r->route->upload_end(r);
 		else
-			handle(x);
+			r->route->handle(r);
 	}
 	return queue_reply(x);
 }

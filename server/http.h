@@ -59,6 +59,12 @@ struct request {
  * job), 0 while it is open. */
 int http_client_gone(struct request *r);
 
+/* A submission's costly part (building its tree, validating its case) runs between these, at most
+ * --max-concurrent-submissions at once (request_gate.h): 0 when it may start, -1 after replying 503
+ * when none ended within SUBMISSION_WAIT_SECONDS. Every 0 is followed by one leave. */
+int http_submission_enter(struct request *r);
+void http_submission_leave(struct request *r);
+
 /* A request header, or NULL. */
 const char *http_header(struct request *r, const char *name);
 /* A query parameter, percent-decoded into out: 1 if present, 0 if absent, -1 if it does not
@@ -97,8 +103,7 @@ enum body_kind {
 /* A route: method, path pattern ("/v1/jobs/{id}/files/{name}"; {name} as the last element takes
  * the rest of the path, slashes included, so hostile names reach the handler and are refused
  * there), the roles allowed, the body it takes, and either a handler or the upload callbacks.
- * A submission route (body BODY_CASE) waits for its turn among the submissions being validated
- * (request_gate.h). Every GET route answers HEAD too. */
+ * Every GET route answers HEAD too. */
 typedef void (*handler_fn)(struct request *r);
 struct route {
 	const char *method;

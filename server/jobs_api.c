@@ -132,52 +132,99 @@ static int idempotency_key(struct request *r, const char **key)
 	return 0;
 }
 
-void jobs_submit(struct request *r)
+/* What a checked submission stores: its canonical case and request digests, without the trees
+ * they came from. */
+struct submission {
+	char *canonical;                 /* the case in canonical form, owned */
+	char *name;                      /* owned, or NULL */
+	const char *key;                 /* the Idempotency-Key header, or NULL */
+	long long priority, threads, wall;
+	char case_sha[DIGEST_HEX_SIZE], body_sha[DIGEST_HEX_SIZE];
+};
+
+static void submission_release(struct submission *s)
+{
+	free(s->canonical);
+	free(s->name);
+}
+
+/* The costly part of a submission: parses the body, checks the request and validates the case,
+ * then frees both trees (and the body's text), keeping only what the store needs. 0, or -1 after
+ * replying. */
+static int submission_check(struct request *r, struct submission *s)
 {
 	static const char *const keys[] = { "case", "priority", "threads", "wall_time_seconds", "name", NULL };
 	json_t *body = api_body_object(r);
 	if (!body)
-		return;
-	long long priority, threads, wall;
-	const char *name, *key;
+		return -1;
+	const char *name;
 	char *whole = NULL;
 	struct case_spec *loaded = NULL;
+	int rc = -1;
 	json_t *case_spec = json_object_get(body, "case");
-	if (api_known_keys(r, body, keys) || idempotency_key(r, &key))
+	if (api_known_keys(r, body, keys) || idempotency_key(r, &s->key))
 		goto done;
 	if (!json_is_object(case_spec)) {
 		reply_fail(r, API_INVALID_REQUEST, "/case", case_spec ? "'case' must be an object" : "missing required key 'case'");
 		goto done;
 	}
-	if (api_int_member(r, body, "priority", PRIORITY_MIN, PRIORITY_MAX, 0, &priority) ||
-	    api_int_member(r, body, "threads", 1, THREADS_MAX, 1, &threads) || check_threads(r, threads) ||
-	    api_int_member(r, body, "wall_time_seconds", 1, WALL_TIME_MAX, WALL_TIME_DEFAULT, &wall) ||
+	if (api_int_member(r, body, "priority", PRIORITY_MIN, PRIORITY_MAX, 0, &s->priority) ||
+	    api_int_member(r, body, "threads", 1, THREADS_MAX, 1, &s->threads) || check_threads(r, s->threads) ||
+	    api_int_member(r, body, "wall_time_seconds", 1, WALL_TIME_MAX, WALL_TIME_DEFAULT, &s->wall) ||
 	    api_string_member(r, body, "name", SERVER_NAME_MAX, 0, &name) || check_case(r, case_spec, &loaded))
 		goto done;
-	const char *canonical = loaded->json;
 	whole = json_dumps(body, JSON_COMPACT | JSON_SORT_KEYS);
-	char case_sha[DIGEST_HEX_SIZE], body_sha[DIGEST_HEX_SIZE];
-	digest_hex(canonical, strlen(canonical), case_sha);
-	digest_hex(whole ? whole : "", whole ? strlen(whole) : 0, body_sha);
-	struct job_submit in = { .who = &r->who, .idempotency_key = key, .body_sha256 = body_sha,
-				 .case_json = canonical, .case_sha256 = case_sha, .name = name,
-				 .priority = (int)priority, .threads = (int)threads,
-				 .wall_time_seconds = (int)wall };
+	s->name = name ? strdup(name) : NULL;
+	if (!whole || (name && !s->name)) {
+		reply_fail(r, API_UNAVAILABLE, "", "no memory to store the case: retry later");
+		goto done;
+	}
+	s->canonical = loaded->json; /* taken from the loaded case, which is freed below */
+	loaded->json = NULL;
+	digest_hex(s->canonical, strlen(s->canonical), s->case_sha);
+	digest_hex(whole, strlen(whole), s->body_sha);
+	rc = 0;
+done:
+	case_destroy(&loaded);
+	free(whole);
+	json_decref(body);
+	free(r->body); /* the text is not needed any more either: free it before the durable write */
+	r->body = NULL;
+	r->body_size = 0;
+	return rc;
+}
+
+/* Parsing and validation take their turn among the submissions being checked
+ * (http_submission_enter); the durable write, which waits on an fsync, does not, so group commit
+ * still gathers every submission in flight into one transaction. */
+void jobs_submit(struct request *r)
+{
+	struct submission s = { 0 };
+	if (http_submission_enter(r) != 0)
+		return;
+	int checked = submission_check(r, &s) == 0;
+	http_submission_leave(r);
+	if (!checked) {
+		submission_release(&s);
+		return;
+	}
+	struct job_submit in = { .who = &r->who, .idempotency_key = s.key, .body_sha256 = s.body_sha,
+				 .case_json = s.canonical, .case_sha256 = s.case_sha, .name = s.name,
+				 .priority = (int)s.priority, .threads = (int)s.threads,
+				 .wall_time_seconds = (int)s.wall };
 	json_t *job = NULL;
 	int created = 0;
 	struct api_error err = { 0 };
 	if (store_job_submit(r->srv->store, &in, &job, &created, &err) != API_OK) {
 		reply_error(r, &err);
-		goto done;
+	} else {
+		char location[64];
+		snprintf(location, sizeof location, "/v1/jobs/%lld",
+			 (long long)json_integer_value(json_object_get(job, "id")));
+		reply_header(r, "Location", location);
+		reply_json(r, created ? 201 : 200, job);
 	}
-	char location[64];
-	snprintf(location, sizeof location, "/v1/jobs/%lld", (long long)json_integer_value(json_object_get(job, "id")));
-	reply_header(r, "Location", location);
-	reply_json(r, created ? 201 : 200, job);
-done:
-	case_destroy(&loaded);
-	free(whole);
-	json_decref(body);
+	submission_release(&s);
 }
 
 static int parse_states(struct request *r, unsigned *mask)
