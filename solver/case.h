@@ -48,7 +48,7 @@
 
 enum case_scheme { SCHEME_SEMI_IMPLICIT };
 enum case_phases { PHASES_DOUBLE_POINT, PHASES_SINGLE_POINT };
-enum case_shape { SHAPE_LINEAR, SHAPE_QUADRATIC_BSPLINE, SHAPE_CUBIC_BSPLINE };
+enum case_shape { SHAPE_LINEAR, SHAPE_QUADRATIC_BSPLINE, SHAPE_CUBIC_BSPLINE, SHAPE_GIMP };
 /* The matrix of the pressure solve: the Laplacian of 000 Eq. 61, or the projection G^T M^-1 G
  * consistent with the velocity correction (docs/numerics.md compares them). */
 enum pressure_projection { PROJECTION_LAPLACIAN, PROJECTION_CONSISTENT };
@@ -104,7 +104,7 @@ enum probe_field { FIELD_PORE_PRESSURE, FIELD_STRESS_XX, FIELD_STRESS_YY, FIELD_
 struct case_formulation {
 	enum case_scheme scheme;          /* "semi_implicit" */
 	enum case_phases phases;          /* "double_point" (default) or "single_point" */
-	enum case_shape shape;            /* "linear", "quadratic_bspline" (default) or "cubic_bspline" */
+	enum case_shape shape;            /* "linear", "quadratic_bspline" (default) or "cubic_bspline"; SHAPE_GIMP not offered yet (shape.h) */
 	int pore_pressure_smoothing;      /* node-wise smoothing, 000 Eq. 77; default true */
 	enum velocity_update velocity_update; /* point velocities: "flip" (default, blended with PIC by
 						 flip_fraction), "apic" (affine PIC, transfer.h) or

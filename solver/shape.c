@@ -1,6 +1,6 @@
 /*
- * shape.c - linear, quadratic and cubic B-spline shape functions (see shape.h for the edge
- * treatments).
+ * shape.c - linear, quadratic and cubic B-spline and uGIMP shape functions (see shape.h for the
+ * edge treatments).
  *
  * Local symbols: xi = (x - origin) / h, the coordinate in cells; d = xi - node, the signed distance
  * to a node in cells. Weights are dimensionless, gradients are per metre (multiplied by 1/h).
@@ -11,7 +11,7 @@
 
 int shape_support(enum case_shape kind)
 {
-	return kind == SHAPE_LINEAR ? 2 : kind == SHAPE_CUBIC_BSPLINE ? 4 : 3;
+	return kind == SHAPE_LINEAR ? 2 : kind == SHAPE_CUBIC_BSPLINE ? 4 : 3;   /* GIMP: 3 (half width <= h/2) */
 }
 
 static inline int linear_1d(double xi, idx_t cells, double inv_h, idx_t *i0, double *w, double *dw)
@@ -103,6 +103,67 @@ static int cubic_1d(double xi, idx_t cells, double inv_h, idx_t *i0, double *w, 
 	return 0;
 }
 
+/* G(u) = integral of the hat max(0, 1 - |t|) from -1 to u (u in cells from the node): the
+ * antiderivative GIMP's weights are differences of. */
+static inline double hat_integral(double u)
+{
+	if (u <= -1.0)
+		return 0.0;
+	if (u <= 0.0)
+		return 0.5 * (1.0 + u) * (1.0 + u);
+	if (u <= 1.0)
+		return 1.0 - 0.5 * (1.0 - u) * (1.0 - u);
+	return 1.0;
+}
+
+static inline double hat(double u)
+{
+	return fmax(0.0, 1.0 - fabs(u));
+}
+
+/* uGIMP (Bardenhagen and Kober 2004): S_I(x_p) = (1/|D|) integral over the point's domain D of the
+ * linear hat N_I, with D = [xi - lambda, xi + lambda] (lambda the half width in cells, at most 1/2)
+ * clipped to the grid [0, cells]. Clipping keeps the partition of unity where a domain reaches
+ * past the edge; inside the grid this is the familiar piecewise form (1 - (d^2 + lambda^2) /
+ * (2 lambda) for |d| < lambda, 1 - |d| between, (1 + lambda - |d|)^2 / (4 lambda) in the outer
+ * band, d = xi - I in cells). With a = max(xi - lambda, 0), b = min(xi + lambda, cells) and a', b'
+ * their derivatives in xi (1, or 0 where clipped), dS/dxi = (N(b) b' - N(a) a' - S (b' - a')) /
+ * (b - a). lambda = 0 gives the linear hat. */
+static inline int gimp_1d(double xi, double lambda, idx_t cells, double inv_h, idx_t *i0, double *w, double *dw)
+{
+	if (lambda <= 0.0) {             /* the hat itself, on 3 nodes that stay inside the grid */
+		idx_t i;
+		linear_1d(xi, cells, inv_h, &i, w, dw);
+		w[2] = dw[2] = 0.0;
+		if (i > cells - 2) {       /* last cell: its two nodes are the upper two of the three */
+			w[2] = w[1], w[1] = w[0], w[0] = 0.0;
+			dw[2] = dw[1], dw[1] = dw[0], dw[0] = 0.0;
+			i = cells - 2;
+		}
+		*i0 = i;
+		return 0;
+	}
+	const double a = fmax(xi - lambda, 0.0), b = fmin(xi + lambda, (double)cells);
+	const double da = xi - lambda > 0.0 ? 1.0 : 0.0, db = xi + lambda < (double)cells ? 1.0 : 0.0;
+	idx_t i = (idx_t)floor(a);        /* the domain [a, b], at most a cell long, meets nodes i .. i + 2 */
+	if (i > cells - 2)
+		i = cells - 2;              /* needs cells >= 2; the extra node then gets weight 0 */
+	*i0 = i;
+	for (int k = 0; k < 3; k++) {
+		const double node = (double)(i + k);
+		w[k] = (hat_integral(b - node) - hat_integral(a - node)) / (b - a);
+		dw[k] = (hat(b - node) * db - hat(a - node) * da - w[k] * (db - da)) / (b - a) * inv_h;
+	}
+	return 0;
+}
+
+int shape_1d_gimp(double xi, double half_width, idx_t cells, double inv_h, idx_t *i0, double *w, double *dw)
+{
+	if (!(xi >= 0.0 && xi <= (double)cells))
+		return -1;
+	return gimp_1d(xi, half_width, cells, inv_h, i0, w, dw);
+}
+
 /* shape_1d's body, inlined where kind is a constant so that the dispatch folds away. */
 static inline int evaluate_1d(enum case_shape kind, double xi, idx_t cells, double inv_h, idx_t *i0, double *w,
 			      double *dw)
@@ -113,6 +174,8 @@ static inline int evaluate_1d(enum case_shape kind, double xi, idx_t cells, doub
 		return linear_1d(xi, cells, inv_h, i0, w, dw);
 	if (kind == SHAPE_CUBIC_BSPLINE)
 		return cubic_1d(xi, cells, inv_h, i0, w, dw);
+	if (kind == SHAPE_GIMP)
+		return gimp_1d(xi, 0.0, cells, inv_h, i0, w, dw);   /* a location: no domain of its own */
 	return quadratic_1d(xi, cells, inv_h, i0, w, dw);
 }
 
@@ -147,6 +210,15 @@ static inline int evaluate_point(const struct grid *g, enum case_shape kind, con
 	idx_t i0 = 0, j0 = 0;
 	const double xi = (p->x[2 * q] - g->origin[0]) * g->inv_h;
 	const double eta = (p->x[2 * q + 1] - g->origin[1]) * g->inv_h;
+	if (kind == SHAPE_GIMP) {
+		/* uGIMP: the square domain of the point's initial volume, kept through the motion */
+		const double lambda = fmin(0.5 * sqrt(p->volume0[q]) * g->inv_h, 0.5);   /* one point per cell at most */
+		if (shape_1d_gimp(xi, lambda, g->cells[0], g->inv_h, &i0, f, f + 2 * S) ||
+		    shape_1d_gimp(eta, lambda, g->cells[1], g->inv_h, &j0, f + S, f + 3 * S))
+			return -1;
+		p->node0[q] = grid_node(g, i0, j0);
+		return 0;
+	}
 	if (evaluate_1d(kind, xi, g->cells[0], g->inv_h, &i0, f, f + 2 * S) ||
 	    evaluate_1d(kind, eta, g->cells[1], g->inv_h, &j0, f + S, f + 3 * S))
 		return -1;
@@ -165,6 +237,7 @@ enum poro_status shape_evaluate(const struct grid *g, enum case_shape kind, stru
 		switch (kind) {
 		case SHAPE_LINEAR: outside = evaluate_point(g, SHAPE_LINEAR, 2, p, q); break;
 		case SHAPE_CUBIC_BSPLINE: outside = evaluate_point(g, SHAPE_CUBIC_BSPLINE, 4, p, q); break;
+		case SHAPE_GIMP: outside = evaluate_point(g, SHAPE_GIMP, 3, p, q); break;
 		default: outside = evaluate_point(g, SHAPE_QUADRATIC_BSPLINE, 3, p, q); break;
 		}
 		if (outside) {

@@ -3,14 +3,35 @@
  * high-entropy points, including the half cells next to the grid edges; gradients against
  * central finite differences of the weights; non-negativity; the interpolating edge property;
  * reproduction of linear fields (sum S_i x_i = x, sum dS_i x_i = 1) for linear, quadratic and
- * cubic B-splines, the cubic ones with their boundary-modified edge cells (shape.h).
+ * cubic B-splines, the cubic ones with their boundary-modified edge cells (shape.h), and uGIMP at
+ * several half widths, its domains clipped at the edges; uGIMP against its closed form inside the
+ * grid and against the linear hat at zero width.
  */
 #include "../harness.h"
 #include "shape.h"
 
 #define SAMPLES 20000
 
-static void check_kind(enum case_shape kind, const char *label)
+/* One kind's 1-D weights; `lambda` is uGIMP's half width in cells (ignored by the B-splines). */
+static int weights_1d(enum case_shape kind, double lambda, double xi, idx_t cells, double inv_h, idx_t *i0, double *w,
+		      double *dw)
+{
+	return kind == SHAPE_GIMP ? shape_1d_gimp(xi, lambda, cells, inv_h, i0, w, dw)
+				  : shape_1d(kind, xi, cells, inv_h, i0, w, dw);
+}
+
+/* Whether xi lies within 1e-4 cells of a place where a kind's pieces join (where a central
+ * difference straddles two pieces): integers and half-integers for the B-splines, integers +-
+ * lambda for uGIMP (|d| = lambda, 1 - lambda, 1 + lambda, and the clipping at the edges). */
+static int near_a_join(enum case_shape kind, double lambda, double xi)
+{
+	if (kind == SHAPE_GIMP)
+		return fabs(xi - lambda - round(xi - lambda)) < 1e-4 || fabs(xi + lambda - round(xi + lambda)) < 1e-4 ||
+		       fabs(xi - round(xi)) < 1e-4;
+	return fabs(2 * xi - round(2 * xi)) < 1e-4;
+}
+
+static void check_kind(enum case_shape kind, double lambda, const char *label)
 {
 	const idx_t cells = 7;
 	const double h = 0.0371, inv_h = 1.0 / h;
@@ -22,7 +43,7 @@ static void check_kind(enum case_shape kind, const char *label)
 		double xi = k % 4 == 0 ? rnd(0, 2) : k % 4 == 1 ? rnd(cells - 2, cells) : rnd(0, cells);
 		idx_t i0;
 		double w[SHAPE_SUPPORT_MAX], dw[SHAPE_SUPPORT_MAX];
-		shape_1d(kind, xi, cells, inv_h, &i0, w, dw);
+		weights_1d(kind, lambda, xi, cells, inv_h, &i0, w, dw);
 		if (i0 < 0 || i0 + S - 1 > cells)
 			out_of_range++;
 		double sum = 0, gsum = 0;
@@ -32,21 +53,27 @@ static void check_kind(enum case_shape kind, const char *label)
 		}
 		worst_sum = fmax(worst_sum, fabs(sum - 1));
 		worst_grad = fmax(worst_grad, fabs(gsum) * h);
-		/* linear field u = x (in cells): sum S_a (i0 + a) = xi, sum dS_a (i0 + a) = 1 / h */
-		double lin = 0, dlin = 0;
+		/* linear field u = x (in cells): sum S_a (i0 + a) = xi, sum dS_a (i0 + a) = 1 / h; uGIMP
+		 * gives the mean of x over its domain, the domain's centre, which moves with xi at half
+		 * the rate where one end is clipped at an edge (xi itself wherever the domain is inside) */
+		double lin = 0, dlin = 0, centre = xi, dcentre = 1;
+		if (kind == SHAPE_GIMP && lambda > 0) {
+			const double lo = fmax(xi - lambda, 0), hi = fmin(xi + lambda, (double)cells);
+			centre = 0.5 * (lo + hi);
+			dcentre = 0.5 * ((xi - lambda > 0) + (xi + lambda < cells));
+		}
 		for (int a = 0; a < S; a++)
 			lin += w[a] * (double)(i0 + a), dlin += dw[a] * (double)(i0 + a);
-		worst_lin = fmax(worst_lin, fabs(lin - xi) / cells);
-		worst_dlin = fmax(worst_dlin, fabs(dlin * h - 1));
+		worst_lin = fmax(worst_lin, fabs(lin - centre) / cells);
+		worst_dlin = fmax(worst_dlin, fabs(dlin * h - dcentre));
 		/* finite difference of node i0+a's weight in x (in metres) */
 		const double eps = 1e-6;
-		double half = 2 * xi;   /* pieces join at integers (linear, cubic) and half-integers (quadratic) */
-		if (xi > eps && xi < cells - eps && fabs(half - round(half)) > 1e-4) {
+		if (xi > eps && xi < cells - eps && !near_a_join(kind, lambda, xi)) {
 			for (int a = 0; a < S; a++) {
 				double wp[SHAPE_SUPPORT_MAX], wm[SHAPE_SUPPORT_MAX], d[SHAPE_SUPPORT_MAX];
 				idx_t ip, im;
-				shape_1d(kind, xi + eps, cells, inv_h, &ip, wp, d);
-				shape_1d(kind, xi - eps, cells, inv_h, &im, wm, d);
+				weights_1d(kind, lambda, xi + eps, cells, inv_h, &ip, wp, d);
+				weights_1d(kind, lambda, xi - eps, cells, inv_h, &im, wm, d);
 				double vp = 0, vm = 0;   /* weight of node i0+a seen from either side */
 				if (i0 + a - ip >= 0 && i0 + a - ip < S) vp = wp[i0 + a - ip];
 				if (i0 + a - im >= 0 && i0 + a - im < S) vm = wm[i0 + a - im];
@@ -72,23 +99,27 @@ static void check_kind(enum case_shape kind, const char *label)
 	snprintf(name, sizeof name, "%s_support_inside_grid", label);
 	CHECK(out_of_range == 0, name, "%d samples reach beyond the grid", out_of_range);
 
-	/* interpolating at the edges: the edge node's weight is 1 there */
+	/* interpolating at the edges: the edge node's weight is 1 there (not uGIMP with a width: a
+	 * point on the edge averages the hat over the half of its domain inside the grid) */
 	idx_t i0;
 	double w[SHAPE_SUPPORT_MAX], dw[SHAPE_SUPPORT_MAX];
-	shape_1d(kind, 0.0, cells, inv_h, &i0, w, dw);
-	int lower = i0 == 0 && fabs(w[0] - 1) < 1e-15;
-	shape_1d(kind, (double)cells, cells, inv_h, &i0, w, dw);
-	int upper = i0 + S - 1 == cells && fabs(w[S - 1] - 1) < 1e-15;
-	snprintf(name, sizeof name, "%s_interpolating_at_edges", label);
-	CHECK(lower && upper, name, "edge weights not 1");
+	if (kind != SHAPE_GIMP || lambda == 0.0) {
+		weights_1d(kind, lambda, 0.0, cells, inv_h, &i0, w, dw);
+		int lower = i0 == 0 && fabs(w[0] - 1) < 1e-15;
+		weights_1d(kind, lambda, (double)cells, cells, inv_h, &i0, w, dw);
+		int upper = i0 + S - 1 == cells && fabs(w[S - 1] - 1) < 1e-15;
+		snprintf(name, sizeof name, "%s_interpolating_at_edges", label);
+		CHECK(lower && upper, name, "edge weights not 1");
+	}
 	snprintf(name, sizeof name, "%s_outside_rejected", label);
-	CHECK(shape_1d(kind, -1e-9, cells, inv_h, &i0, w, dw) == -1 &&
-	      shape_1d(kind, cells + 1e-9, cells, inv_h, &i0, w, dw) == -1, name, "a point outside was accepted");
+	CHECK(weights_1d(kind, lambda, -1e-9, cells, inv_h, &i0, w, dw) == -1 &&
+	      weights_1d(kind, lambda, cells + 1e-9, cells, inv_h, &i0, w, dw) == -1, name, "a point outside was accepted");
 }
 
 /* 2-D: the tensor product keeps both properties at random points of a whole grid. */
 static void check_2d(enum case_shape kind, const char *label)
 {
+	const double spacing = 0.0413 / 2;   /* uGIMP: 2x2 points per cell, half width h/4 */
 	struct case_grid spec = {.origin = {-1.234, 0.567}, .extent = {6 * 0.0413, 5 * 0.0413}, .cell_size = 0.0413};
 	struct grid g;
 	grid_init(&g, &spec, NULL);
@@ -97,6 +128,7 @@ static void check_2d(enum case_shape kind, const char *label)
 	for (idx_t q = 0; q < p.n; q++) {
 		p.x[2 * q] = spec.origin[0] + rnd(0, spec.extent[0]);
 		p.x[2 * q + 1] = spec.origin[1] + rnd(0, spec.extent[1]);
+		p.volume0[q] = spacing * spacing;
 	}
 	enum poro_status st = shape_evaluate(&g, kind, &p, "test", NULL);
 	int S = p.support, nn = S * S;
@@ -155,14 +187,65 @@ static void check_cubic_closed_form(void)
 	CHECK(worst < 1e-14, "cubic_bspline_matches_closed_form", "max difference %.3e", worst);
 }
 
+/* uGIMP inside the grid against Bardenhagen and Kober's piecewise form (d = xi - I in cells,
+ * lambda the half width): S = 1 - (d^2 + lambda^2) / (2 lambda) for |d| < lambda, 1 - |d| for
+ * lambda <= |d| < 1 - lambda, (1 + lambda - |d|)^2 / (4 lambda) for 1 - lambda <= |d| < 1 + lambda;
+ * and at zero width, the linear hat's weights. */
+static void check_gimp_closed_form(void)
+{
+	const idx_t cells = 8;
+	const double inv_h = 1.0 / 0.0311;
+	double worst = 0, worst_grad = 0, worst_hat = 0;
+	for (int k = 0; k < 4000; k++) {
+		const double lambda = rnd(0.01, 0.5), xi = rnd(lambda, cells - lambda);   /* domain inside the grid */
+		double w[SHAPE_SUPPORT_MAX], dw[SHAPE_SUPPORT_MAX];
+		idx_t i0;
+		shape_1d_gimp(xi, lambda, cells, inv_h, &i0, w, dw);
+		for (int a = 0; a < 3; a++) {
+			const double d = xi - (double)(i0 + a), ad = fabs(d), sg = d < 0 ? -1.0 : 1.0;
+			double ref = 0, dref = 0;   /* dref: dS/dxi */
+			if (ad < lambda)
+				ref = 1 - (d * d + lambda * lambda) / (2 * lambda), dref = -d / lambda;
+			else if (ad < 1 - lambda)
+				ref = 1 - ad, dref = -sg;
+			else if (ad < 1 + lambda)
+				ref = (1 + lambda - ad) * (1 + lambda - ad) / (4 * lambda), dref = -sg * (1 + lambda - ad) / (2 * lambda);
+			worst = fmax(worst, fabs(w[a] - ref));
+			worst_grad = fmax(worst_grad, fabs(dw[a] / inv_h - dref));
+		}
+		/* zero width: the hat's two weights on the same nodes */
+		double wl[SHAPE_SUPPORT_MAX], dl[SHAPE_SUPPORT_MAX];
+		idx_t il;
+		shape_1d_gimp(xi, 0.0, cells, inv_h, &i0, w, dw);
+		shape_1d(SHAPE_LINEAR, xi, cells, inv_h, &il, wl, dl);
+		for (int a = 0; a < 3; a++) {
+			const idx_t node = i0 + a;
+			const double lin = node == il ? wl[0] : node == il + 1 ? wl[1] : 0.0;
+			const double dlin = node == il ? dl[0] : node == il + 1 ? dl[1] : 0.0;
+			worst_hat = fmax(worst_hat, fmax(fabs(w[a] - lin), fabs(dw[a] - dlin) / inv_h));
+		}
+	}
+	printf("INFO gimp: max difference from the closed form %.2e (weights), %.2e (gradients h); zero width from "
+	       "the linear hat %.2e\n", worst, worst_grad, worst_hat);
+	CHECK(worst < 1e-14 && worst_grad < 1e-13, "gimp_matches_closed_form", "weights %.3e gradients %.3e", worst,
+	      worst_grad);
+	CHECK(worst_hat < 1e-15, "gimp_zero_width_is_linear", "difference %.3e", worst_hat);
+}
+
 int main(void)
 {
-	check_kind(SHAPE_LINEAR, "linear");
-	check_kind(SHAPE_QUADRATIC_BSPLINE, "quadratic_bspline");
-	check_kind(SHAPE_CUBIC_BSPLINE, "cubic_bspline");
+	check_kind(SHAPE_LINEAR, 0, "linear");
+	check_kind(SHAPE_QUADRATIC_BSPLINE, 0, "quadratic_bspline");
+	check_kind(SHAPE_CUBIC_BSPLINE, 0, "cubic_bspline");
+	check_kind(SHAPE_GIMP, 0.25, "gimp_2x2");       /* half widths of 2, 3 and 1 points per cell */
+	check_kind(SHAPE_GIMP, 1.0 / 6, "gimp_3x3");
+	check_kind(SHAPE_GIMP, 0.5, "gimp_1x1");
+	check_kind(SHAPE_GIMP, 0.0, "gimp_zero_width");
 	check_cubic_closed_form();
+	check_gimp_closed_form();
 	check_2d(SHAPE_LINEAR, "linear");
 	check_2d(SHAPE_QUADRATIC_BSPLINE, "quadratic_bspline");
 	check_2d(SHAPE_CUBIC_BSPLINE, "cubic_bspline");
+	check_2d(SHAPE_GIMP, "gimp");
 	HARNESS_EXIT();
 }
