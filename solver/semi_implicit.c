@@ -31,6 +31,9 @@
  *    the gradient of that displacement, and with FLIP noise in the point velocities (which the
  *    MUSL remap carries and v^{t+1} does not) the two drift apart otherwise: 7.2% of the
  *    double-point Xie-Leo column's settlement (docs/numerics.md, "Volumes that follow the motion").
+ *  - a rigid plate on a grid face (boundaries.<face>.soil "plate") makes the face's normal
+ *    velocity, both phases, one degree of freedom, set after the predictors and solved with the
+ *    pressure increment (plate.c): updated from the last step's pressure alone it diverged.
  * Single point: the water set rides on the soil points (same positions, volumes, porosity), so
  * every formula below serves both variants; only the water points' own motion differs.
  */
