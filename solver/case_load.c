@@ -415,6 +415,11 @@ static void read_plate(struct case_reader *r, const json_t *face, const char *p,
 	}
 	if (!o)
 		return;
+	if (b->drainage == DRAINAGE_DRAINED) {
+		char drainage[CASE_POINTER_MAX];
+		case_pointer_key(drainage, p, "drainage");
+		case_problem(r, drainage, "must be \"impermeable\" under a plate (no water passes it)");
+	}
 	case_check_keys(r, o, pointer, plate_keys);
 	case_read_number(r, o, pointer, "force", CASE_REQUIRED, NULL, &b->plate.force);
 	read_time_function(r, o, pointer, &b->plate.time_function);

@@ -718,6 +718,8 @@ static void test_plate(void)
 		  "/boundaries/top/water: \"plate\" needs the soil to be \"plate\"" },
 		{ "fixed corner beside a plate", "/boundaries/left/soil", "\"fixed\"",
 		  "/boundaries/left: cannot be \"fixed\" beside the plate on the top face" },
+		{ "drained plate", "/boundaries/top/drainage", "\"drained\"",
+		  "/boundaries/top/drainage: must be \"impermeable\" under a plate" },
 		{ "plate with the consistent projection", "/formulation/pressure_projection", "\"consistent\"",
 		  "/boundaries/top: a plate needs formulation.pressure_projection \"laplacian\"" },
 	};
