@@ -17,10 +17,15 @@
  *  b. the series against an explicit finite-difference solution of the equations above (400
  *     intervals), at Tv = 0.01 to 1: the same solution to 1e-3 p0, the Mandel-Cryer rise included;
  *  c. the quarter model of tests/cases/mandel.json (rigid smooth plate on top, the centre lines
- *     slip walls, the side x = a drained and free), single and double point, against the series:
- *     the pressure at the centre and the profile p(x) (point pressures averaged over one cell
- *     wide bins), within 5% of p0 at Tv = 0.01, 0.05, 0.1, 0.2, 0.5, 1; and the plate's force
- *     balance: the soil's mean vertical stress under the plate equals F / a.
+ *     slip walls, the side x = a the grid's face, drained and free), single and double point,
+ *     against the series for its ramped force (the step response averaged over the ramp; the
+ *     ramp keeps the layer's elastic ringing small, docs/numerics.md): the pressure at the centre
+ *     and the profile p(x) (point pressures averaged over one cell wide bins), within 5% of p0 at
+ *     Tv = 0.01, 0.05, 0.1, 0.2, 0.5, 1; and the plate's force balance: the layer's mean total
+ *     vertical stress equals F / a within 2%;
+ *  d. the same with the drained side inside the grid (a free surface on a grid line): with APIC
+ *     as c; with the paper's pure FLIP the pressure next to the side drifts from Tv ~ 0.5 (0.27 p0
+ *     at Tv = 1), reported as XFAIL while it lasts (docs/numerics.md, "Mandel's problem").
  * With PORO_VERIFY_LONG=1 the model also runs at half the cell size.
  * MANDEL_CASE=file runs that case instead, printing its errors (for measuring other set-ups).
  */
