@@ -3,7 +3,8 @@
  * displacement of step 8a), shared by every scheme.
  *
  * Each face's soil and water constraints are independent of its drainage (pressure.c): a fixed
- * face may be drained. "slip" fixes the normal component (a roller), "fixed" both. With the
+ * face may be drained. "slip" fixes the normal component (a roller), "fixed" both, "plate" marks
+ * the normal component as a wall whose velocity plate.c sets. With the
  * interpolating edge basis of shape.h, a constraint on the edge nodes is exact at the wall.
  */
 #include <string.h>
@@ -12,7 +13,8 @@
 
 static unsigned char constraint_bits(enum face_constraint c, int normal_bit)
 {
-	return c == CONSTRAINT_FIXED ? 3 : c == CONSTRAINT_SLIP ? (unsigned char)normal_bit : 0;
+	/* a plate's normal component is a wall that moves with the plate (plate.c) */
+	return c == CONSTRAINT_FIXED ? 3 : c == CONSTRAINT_SLIP || c == CONSTRAINT_PLATE ? (unsigned char)normal_bit : 0;
 }
 
 void boundary_mark(struct sim *s)

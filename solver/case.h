@@ -88,8 +88,9 @@ enum permeability_law {
 };
 
 /* Velocity constraint of one phase on a grid face: free, slip (normal component zero: a roller),
- * fixed (both components zero). */
-enum face_constraint { CONSTRAINT_FREE, CONSTRAINT_SLIP, CONSTRAINT_FIXED };
+ * fixed (both components zero), plate (a rigid smooth plate: the normal component is one velocity
+ * shared by the whole face, driven by the plate's force; solver/plate.c). */
+enum face_constraint { CONSTRAINT_FREE, CONSTRAINT_SLIP, CONSTRAINT_FIXED, CONSTRAINT_PLATE };
 /* Drainage of a grid face, independent of its velocity constraint: impermeable (no flux: the
  * natural condition of the pressure equation) or drained (pore pressure zero on the face). */
 enum face_drainage { DRAINAGE_IMPERMEABLE, DRAINAGE_DRAINED };
@@ -202,6 +203,11 @@ struct case_boundary {
 	enum face_constraint soil;        /* soil velocity constraint on the face */
 	enum face_constraint water;       /* water velocity constraint on the face */
 	enum face_drainage drainage;
+	struct {                          /* soil "plate" only: the rigid plate on the face */
+		double force;             /* N per metre of thickness, pushing into the grid along the
+					     face's inward normal (compression positive) */
+		struct case_time_function time_function;   /* scales the force over time */
+	} plate;
 };
 
 struct case_load {

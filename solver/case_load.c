@@ -72,7 +72,7 @@ static const char *const stabilisation_names[] = { "none", "fbar", "modified_fba
 							   NULL };
 static const char *const permeability_law_names[] = { "constant", "kozeny_carman", "volume_ratio",
 							       "volume_ratio_squared", NULL };
-static const char *const constraint_names[] = { "free", "slip", "fixed", NULL };
+static const char *const constraint_names[] = { "free", "slip", "fixed", "plate", NULL };
 static const char *const drainage_names[] = { "impermeable", "drained", NULL };
 static const char *const face_names[] = { "left", "right", "bottom", "top", NULL };
 static const char *const time_function_names[] = { "constant", "ramp", "sinusoid", NULL };
@@ -100,7 +100,8 @@ static const char *const fluid_keys[] = { "density", "bulk_modulus", "cavitation
 					  "cavitated_bulk_modulus", NULL };
 static const char *const gravity_keys[] = { "acceleration", "ramp_time", "elastic_loading", "loading_conductivity",
 						"water_attached", NULL };
-static const char *const face_boundary_keys[] = { "soil", "water", "drainage", NULL };
+static const char *const face_boundary_keys[] = { "soil", "water", "drainage", "plate", NULL };
+static const char *const plate_keys[] = { "force", "time_function", NULL };
 static const char *const load_keys[] = { "body", "face", "from", "to", "traction", "time_function", NULL };
 static const char *const time_keys[] = { "dt", "end", NULL };
 static const char *const output_keys[] = { "frame_interval", "progress_interval", NULL };
@@ -390,6 +391,67 @@ static void read_gravity(struct case_reader *r, const json_t *root, struct case_
 			     "needs a gravity ramp_time > 0: it acts while gravity ramps up");
 }
 
+static void read_time_function(struct case_reader *r, const json_t *o, const char *base,
+			       struct case_time_function *tf);
+
+/* The rigid plate of a face whose soil is "plate" (solver/plate.c): its "plate" object, required
+ * there and refused elsewhere. The plate is impermeable: the water's constraint is "plate" too,
+ * moving with it. */
+static void read_plate(struct case_reader *r, const json_t *face, const char *p, struct case_boundary *b)
+{
+	char pointer[CASE_POINTER_MAX];
+	const int soil = b->soil == CONSTRAINT_PLATE;
+	case_pointer_key(pointer, p, "water");
+	if (b->water == CONSTRAINT_PLATE && !soil)
+		case_problem(r, pointer, "\"plate\" needs the soil to be \"plate\" on the same face");
+	else if (soil && b->water != CONSTRAINT_PLATE)
+		case_problem(r, pointer, "must be \"plate\" under a plate (it is impermeable: the water moves "
+			     "with it), got \"%s\"", constraint_names[b->water]);
+	const json_t *o = case_read_object(r, face, p, "plate", soil ? CASE_REQUIRED : CASE_OPTIONAL);
+	case_pointer_key(pointer, p, "plate");
+	if (o && !soil) {
+		case_problem(r, pointer, "needs \"soil\": \"plate\" on the same face");
+		return;
+	}
+	if (!o)
+		return;
+	if (b->drainage == DRAINAGE_DRAINED) {
+		char drainage[CASE_POINTER_MAX];
+		case_pointer_key(drainage, p, "drainage");
+		case_problem(r, drainage, "must be \"impermeable\" under a plate (no water passes it)");
+	}
+	case_check_keys(r, o, pointer, plate_keys);
+	case_read_number(r, o, pointer, "force", CASE_REQUIRED, NULL, &b->plate.force);
+	read_time_function(r, o, pointer, &b->plate.time_function);
+}
+
+/* A plate's nodes share one normal velocity, so a neighbouring face may not fix that component at
+ * the corner they share ("fixed" there would hold the whole plate). The plate's velocity is solved
+ * with the pressure through the Laplacian's right-hand side (plate.c); the consistent projection
+ * leaves wall components out of its system, so it is refused with a plate. */
+static void check_plates(struct case_reader *r, const struct case_spec *c)
+{
+	const struct case_boundary *faces = c->boundaries;
+	for (int f = 0; f < FACE_COUNT; f++) {
+		if (faces[f].soil != CONSTRAINT_PLATE)
+			continue;
+		if (c->formulation.pressure_projection != PROJECTION_LAPLACIAN) {
+			char pointer[CASE_POINTER_MAX];
+			case_pointer_key(pointer, "/boundaries", face_names[f]);
+			case_problem(r, pointer, "a plate needs formulation.pressure_projection \"laplacian\"");
+		}
+		const int first = f < FACE_BOTTOM ? FACE_BOTTOM : FACE_LEFT;   /* the faces across the plate */
+		for (int g = first; g < first + 2; g++) {
+			if (faces[g].soil != CONSTRAINT_FIXED && faces[g].water != CONSTRAINT_FIXED)
+				continue;
+			char pointer[CASE_POINTER_MAX];
+			case_pointer_key(pointer, "/boundaries", face_names[g]);
+			case_problem(r, pointer, "cannot be \"fixed\" beside the plate on the %s face: their corner "
+				     "would hold the plate (use \"slip\")", face_names[f]);
+		}
+	}
+}
+
 static void read_boundaries(struct case_reader *r, const json_t *root, struct case_boundary *faces)
 {
 	const json_t *o = case_read_object(r, root, "", "boundaries", CASE_OPTIONAL);
@@ -408,6 +470,7 @@ static void read_boundaries(struct case_reader *r, const json_t *root, struct ca
 		b->water = read_choice_or(r, face, p, "water", CASE_OPTIONAL, constraint_names, b->water);
 		b->drainage = read_choice_or(r, face, p, "drainage", CASE_OPTIONAL, drainage_names,
 					     b->drainage);
+		read_plate(r, face, p, b);
 	}
 }
 
@@ -649,6 +712,7 @@ static void read_case(struct case_reader *r, const json_t *root, struct case_spe
 	read_fluid(r, root, c);
 	read_gravity(r, root, c);
 	read_boundaries(r, root, c->boundaries);
+	check_plates(r, c);
 	read_loads(r, root, c, bodies_read ? &bodies : NULL);
 	case_names_release(&bodies);
 	int time_ok = read_time(r, root, c);

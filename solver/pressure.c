@@ -341,18 +341,18 @@ static void scale_by_mobility_ratio(struct sim *s, const struct particles *p, do
 		coef[q] *= scratch[q];
 }
 
-/* Right-hand side (D_s v_s* + D_w v_w*) / dt, Eqs. 62-63 evaluated through the point divergences. */
-static void assemble_rhs(struct sim *s)
+/* Right-hand side (D_s v_s + D_w v_w) / dt, Eqs. 62-63 evaluated through the point divergences. */
+void pressure_divergence_rhs(struct sim *s, const double *v_s, const double *v_w, double *out)
 {
 	struct grid_fields *f = &s->f;
 	const struct grid *g = &s->grid;
 	double *sum_s = f->correction_s, *sum_w = f->correction_w;   /* free until step 6 */
 	memset(sum_s, 0, sizeof(double) * (size_t)g->node_count);
 	memset(sum_w, 0, sizeof(double) * (size_t)g->node_count);
-	p2g_point_divergence(g, &s->soil, s->soil.volume, f->v_s_star, sum_s);
-	p2g_point_divergence(g, &s->water, s->water.volume, f->v_w_star, sum_w);
+	p2g_point_divergence(g, &s->soil, s->soil.volume, v_s, sum_s);
+	p2g_point_divergence(g, &s->water, s->water.volume, v_w, sum_w);
 	for (idx_t I = 0; I < g->node_count; I++)
-		f->rhs[I] = ((1.0 - f->porosity[I]) * sum_s[I] + f->porosity[I] * sum_w[I]) / s->dt;
+		out[I] = ((1.0 - f->porosity[I]) * sum_s[I] + f->porosity[I] * sum_w[I]) / s->dt;
 	memset(sum_s, 0, sizeof(double) * (size_t)g->node_count);
 	memset(sum_w, 0, sizeof(double) * (size_t)g->node_count);
 }
@@ -448,7 +448,7 @@ enum poro_status pressure_solve(struct sim *s)
 		scale_by_mobility_ratio(s, w, s->water_coef, s->water_scalar);
 		assemble_laplacian(s, p, s->soil_coef);
 		assemble_laplacian(s, w, s->water_coef);
-		assemble_rhs(s);
+		pressure_divergence_rhs(s, s->f.v_s_star, s->f.v_w_star, s->f.rhs);
 	}
 	cavitation_add_storage(s);   /* cavitation.c */
 	idx_t n = build_reduced_system(s, diagonal_mean);
@@ -462,5 +462,5 @@ enum poro_status pressure_solve(struct sim *s)
 	for (idx_t I = 0; I < s->grid.node_count; I++)
 		if (ps->unknown[I] >= 0)
 			s->f.dp[I] = ps->x[ps->unknown[I]];
-	return PORO_OK;
+	return s->plate_work ? plate_couple_pressure(s, n) : PORO_OK;   /* rigid plates: plate.c */
 }

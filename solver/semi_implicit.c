@@ -31,6 +31,9 @@
  *    the gradient of that displacement, and with FLIP noise in the point velocities (which the
  *    MUSL remap carries and v^{t+1} does not) the two drift apart otherwise: 7.2% of the
  *    double-point Xie-Leo column's settlement (docs/numerics.md, "Volumes that follow the motion").
+ *  - a rigid plate on a grid face (boundaries.<face>.soil "plate") makes the face's normal
+ *    velocity, both phases, one degree of freedom, set after the predictors and solved with the
+ *    pressure increment (plate.c): updated from the last step's pressure alone it diverged.
  * Single point: the water set rides on the soil points (same positions, volumes, porosity), so
  * every formula below serves both variants; only the water points' own motion differs.
  */
@@ -267,6 +270,7 @@ static void predict_velocities(struct sim *s)
 	}
 	boundary_apply(&s->grid, f->fix_w, f->v_w_star);   /* (3e) */
 	boundary_apply(&s->grid, f->fix_s, f->v_s_star);   /* (4d) */
+	plate_predict(s);                                  /* rigid plates: their walls move with V* */
 }
 
 /* Step 6: velocity correction, Eqs. 64-68. The pressure increment pushes the soil with
@@ -308,6 +312,7 @@ static void correct_velocities(struct sim *s)
 	}
 	boundary_apply(g, f->fix_w, f->v_w);
 	boundary_apply(g, f->fix_s, f->v_s);
+	plate_correct(s);   /* rigid plates: V = V* + the increment's push on them */
 }
 
 /* x_p += dt v_p for every point of the set; returns how many then lie beyond a grid face. */
@@ -538,6 +543,7 @@ static enum poro_status update_soil_kinematics(struct sim *s)
 		for (int c = 0; c < 2; c++)
 			f->du_s[2 * I + c] = f->mass_s[I] > 0.0 ? s->dt * f->du_s[2 * I + c] / f->mass_s[I] : 0.0;
 	boundary_apply(&s->grid, f->fix_s, f->du_s);
+	plate_displace(s, f->du_s);
 	g2p_vector_gradient(&s->grid, p, f->du_s, p->dF);
 	if (s->spec->formulation.position_update == POSITION_UPDATE_MUSL_DISPLACEMENT) {
 		/* 7b from the field whose gradient is dF, so volume and motion stay one (file comment) */

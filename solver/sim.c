@@ -142,6 +142,11 @@ static enum poro_status allocate_scratch(struct sim *s)
 	s->patch_mass_Je = calloc((size_t)s->grid.cell_count, sizeof(double));
 	s->probe_point = calloc((size_t)s->spec->probe_count + 1, sizeof(int));
 	s->load_bands = calloc((size_t)s->spec->load_count + 1, sizeof *s->load_bands);
+	int plates = 0;
+	for (int f = 0; f < FACE_COUNT; f++)
+		plates += s->spec->boundaries[f].soil == CONSTRAINT_PLATE;
+	if (plates && !(s->plate_work = calloc((size_t)(FACE_COUNT + 2) * (size_t)s->grid.node_count, sizeof(double))))
+		return poro_error_set(&s->err, PORO_ENOMEM, "cannot allocate the plates' workspace");
 	if (!s->soil_grad || !s->soil_scalar || !s->soil_coef || !s->water_scalar ||
 	    !s->water_coef || !s->cell_fill || !s->cell_fill_soil || !s->patch_mass || !s->patch_mass_Je ||
 	    !s->probe_point || !s->load_bands)
@@ -226,6 +231,7 @@ void sim_destroy(struct sim **ps)
 	free(s->patch_mass_Je);
 	free(s->probe_point);
 	free(s->load_bands);
+	free(s->plate_work);
 	free(s);
 	*ps = NULL;
 }

@@ -75,6 +75,10 @@ struct sim {
 
 	double mapped_mass_s, mapped_mass_w; /* point mass sums mapped in the last P2G, kg/m */
 	double water_outflow_mass;    /* kg/m of water points that left through drained faces */
+	double plate_velocity[FACE_COUNT]; /* normal velocity of each face's rigid plate this step, m/s,
+					      along the grid axis (plate.c; 0 on faces without one) */
+	double *plate_work;           /* [(FACE_COUNT + 2) node_count] the plates' pressure responses and
+					 reduced right-hand side and solution (plate.c); NULL without plates */
 	double phase_seconds[PHASE_COUNT]; /* wall time per phase, accumulated over steps */
 	int *probe_point;             /* [probe_count] tracked point of point probes, -1 otherwise */
 	int resumed;                  /* 1: the state was loaded from a checkpoint (checkpoint.c) */
@@ -129,6 +133,22 @@ void free_surface_add_boundary_term(const struct sim *s, const double *mass, dou
 /* boundary.c: velocity constraints of the grid faces (000 §4.5 steps 3e, 4d, 6d). */
 void boundary_mark(struct sim *s);
 void boundary_apply(const struct grid *g, const unsigned char *fix, double *v);
+
+/* plate.c: rigid smooth plates on grid faces (boundaries.<face>.soil "plate"). plate_predict sets
+ * the plates' normal velocity V* from the tied nodes' momentum and forces after the predictors
+ * (f->force must hold Eq. 52's mixture force) and writes it into v_s*, v_w*; plate_couple_pressure,
+ * after the pressure solve (reduced system of n unknowns in s->ps, its solution in f->dp), makes
+ * the plates' velocities part of it; plate_correct adds the pressure increment's push to V and
+ * writes V into v_s, v_w (step 6); plate_displace writes dt V into the MUSL displacement of step
+ * 8a. f->correction_w and f->du_s serve as scratch where they are free and are left zero. */
+void plate_predict(struct sim *s);
+enum poro_status plate_couple_pressure(struct sim *s, idx_t n);
+void plate_correct(struct sim *s);
+void plate_displace(struct sim *s, double *du_s);
+/* pressure.c: out_I = ((1 - n_I) (D_s v_s)_I + n_I (D_w v_w)_I) / dt, the right-hand side of Eq. 60
+ * for nodal velocities v_s, v_w (Eqs. 62-63 through the point divergences); uses f->correction_s
+ * and f->correction_w as scratch and leaves them zero. */
+void pressure_divergence_rhs(struct sim *s, const double *v_s, const double *v_w, double *out);
 
 /* loads.c: tractions on body faces (000 Eq. 54) and gravity with its ramp. */
 struct load_band {

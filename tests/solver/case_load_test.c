@@ -341,7 +341,7 @@ static void test_wrong_types(void)
 	expect_invalid("array item not an object", "/probes/1", "7",
 		       "/probes/1: expected an object, got number");
 	expect_invalid("unknown enum value", "/boundaries/left/soil", "\"glued\"",
-		       "/boundaries/left/soil: must be one of 'free', 'slip', 'fixed', got 'glued'");
+		       "/boundaries/left/soil: must be one of 'free', 'slip', 'fixed', 'plate', got 'glued'");
 	expect_invalid("wrong schema version", "/schema", "\"poro-case/2\"",
 		       "/schema: must be one of 'poro-case/1'");
 }
@@ -686,6 +686,53 @@ static void test_documented_example(const char *root)
 	free(text);
 }
 
+/* boundaries.<face>.soil "plate" (solver/plate.c): the plate's keys are read, and what cannot be a
+ * rigid impermeable plate is refused with the key named. */
+static void test_plate(void)
+{
+	const char *plate = "{\"soil\": \"plate\", \"water\": \"plate\", \"plate\": {\"force\": 2.5e4, "
+			    "\"time_function\": {\"kind\": \"ramp\", \"ramp_time\": 0.35}}}";
+	const struct edit e[] = { { "/boundaries/top", plate }, { "/boundaries/left", "{\"soil\": \"slip\"}" },
+				  { "/boundaries/bottom", "{\"soil\": \"slip\"}" } };
+	char *text = edited(full_case, e, 3);
+	struct case_spec *c = load_valid("plate case loads", text);
+	if (c) {
+		const struct case_boundary *b = &c->boundaries[FACE_TOP];
+		CHECK(b->soil == CONSTRAINT_PLATE && b->water == CONSTRAINT_PLATE && b->plate.force == 2.5e4 &&
+		      b->plate.time_function.kind == TIME_RAMP && b->plate.time_function.ramp_time == 0.35 &&
+		      c->boundaries[FACE_BOTTOM].plate.force == 0.0, "plate keys read",
+		      "soil %d water %d force %g ramp %g", b->soil, b->water, b->plate.force,
+		      b->plate.time_function.ramp_time);
+	}
+	case_destroy(&c);
+	free(text);
+	const struct {
+		const char *name, *pointer, *value, *needle;
+	} bad[] = {
+		{ "plate without its force", "/boundaries/top/plate", "{}", "/boundaries/top/plate/force: missing required key" },
+		{ "plate without its object", "/boundaries/top/plate", NULL, "/boundaries/top/plate: missing required key" },
+		{ "plate with an unknown key", "/boundaries/top/plate/mass", "1", "/boundaries/top/plate/mass: unknown key" },
+		{ "plate letting water through", "/boundaries/top/water", "\"free\"",
+		  "/boundaries/top/water: must be \"plate\" under a plate" },
+		{ "water plate without a soil plate", "/boundaries/top/soil", "\"slip\"",
+		  "/boundaries/top/water: \"plate\" needs the soil to be \"plate\"" },
+		{ "fixed corner beside a plate", "/boundaries/left/soil", "\"fixed\"",
+		  "/boundaries/left: cannot be \"fixed\" beside the plate on the top face" },
+		{ "drained plate", "/boundaries/top/drainage", "\"drained\"",
+		  "/boundaries/top/drainage: must be \"impermeable\" under a plate" },
+		{ "plate with the consistent projection", "/formulation/pressure_projection", "\"consistent\"",
+		  "/boundaries/top: a plate needs formulation.pressure_projection \"laplacian\"" },
+	};
+	for (size_t i = 0; i < sizeof bad / sizeof *bad; i++) {
+		struct edit all[4] = { e[0], e[1], e[2], { bad[i].pointer, bad[i].value } };
+		const char *needles[] = { bad[i].needle, NULL };
+		expect_invalid_edits(bad[i].name, full_case, all, 4, needles);
+	}
+	const struct edit stray[] = { { "/boundaries/right", "{\"soil\": \"slip\", \"plate\": {\"force\": 1}}" } };
+	const char *needles[] = { "/boundaries/right/plate: needs \"soil\": \"plate\" on the same face", NULL };
+	expect_invalid_edits("plate object on a face without a plate", full_case, stray, 1, needles);
+}
+
 int main(void)
 {
 	char root[256];
@@ -693,6 +740,7 @@ int main(void)
 	test_minimal();
 	test_full();
 	test_cavitation_keys();
+	test_plate();
 	test_malformed();
 	test_wrong_types();
 	test_out_of_range();

@@ -62,6 +62,37 @@ static const char case_format[] =
 	"   {\"name\": \"syy_mid\", \"kind\": \"average\", \"field\": \"stress_yy\","
 	"    \"box\": {\"min\": [0.0, 0.1], \"max\": [0.1, 0.15]}}]%s}";
 
+/* The same column under a rigid plate on the grid's top face (solver/plate.c) instead of the
+ * traction, drained at the bottom: the plate's velocity is rebuilt each step from the nodes'
+ * momentum, so a resumed run needs nothing more in the checkpoint. %s: phases. */
+static const char plate_case_format[] =
+	"{\"schema\": \"poro-case/1\", \"title\": \"checkpoint test column under a plate\","
+	" \"formulation\": {\"scheme\": \"semi_implicit\", \"phases\": \"%s\", \"shape\": \"quadratic_bspline\"},"
+	" \"grid\": {\"origin\": [0.0, 0.0], \"extent\": [0.1, 0.25], \"cell_size\": 0.025},"
+	" \"materials\": [{\"name\": \"silt\", \"model\": \"hencky\", \"density\": 2683,"
+	"   \"youngs_modulus\": 1.37e6, \"poisson_ratio\": 0.23}],"
+	" \"bodies\": [{\"name\": \"column\", \"material\": \"silt\", \"rectangle\": {\"min\": [0.0, 0.0],"
+	"   \"max\": [0.1, 0.25]}, \"particles_per_cell\": 2, \"porosity\": 0.347, \"hydraulic_conductivity\": 2.3e-3}],"
+	" \"fluid\": {\"density\": 1000},"
+	" \"gravity\": {\"acceleration\": [0.0, 0.0]},"
+	" \"boundaries\": {\"left\": {\"soil\": \"slip\", \"water\": \"slip\"},"
+	"   \"right\": {\"soil\": \"slip\", \"water\": \"slip\"},"
+	"   \"bottom\": {\"soil\": \"slip\", \"water\": \"free\", \"drainage\": \"drained\"},"
+	"   \"top\": {\"soil\": \"plate\", \"water\": \"plate\", \"plate\": {\"force\": 2345,"
+	"     \"time_function\": {\"kind\": \"ramp\", \"ramp_time\": 0.0021}}}},"
+	" \"time\": {\"dt\": %g, \"end\": %.17g}, \"output\": {\"frame_interval\": 0.0007},"
+	" \"probes\": [{\"name\": \"p_base\", \"kind\": \"pore_pressure\", \"point\": [0.05, 0.01]},"
+	"   {\"name\": \"settlement\", \"kind\": \"displacement\", \"point\": [0.05, 0.25], \"component\": \"y\"},"
+	"   {\"name\": \"syy_mid\", \"kind\": \"average\", \"field\": \"stress_yy\","
+	"    \"box\": {\"min\": [0.0, 0.1], \"max\": [0.1, 0.15]}}]}";
+
+static char *plate_case_json(const char *phases)
+{
+	static char buf[4096];
+	snprintf(buf, sizeof buf, plate_case_format, phases, DT, (STEPS_BEFORE + STEPS_AFTER) * DT);
+	return buf;
+}
+
 static char *case_json_with(const char *phases, const char *velocity_update, const char *extra)
 {
 	static char buf[4][4096];
@@ -172,11 +203,10 @@ static int identical(const struct sim *a, const struct sim *b)
 
 /* ---- step-level resume ------------------------------------------------------------------------- */
 
-static void test_resume(const char *label, const char *phases, const char *velocity_update)
+static void test_resume_case(const char *label, const char *json)
 {
 	char name[128], path[128];
 	struct case_spec *ca = NULL, *cb = NULL;
-	const char *json = case_json_with(phases, velocity_update, "");
 	char *dir = harness_temp_dir("checkpoint_test");
 	struct sim *a = new_sim(json, &ca), *b = new_sim(json, &cb);
 	snprintf(name, sizeof name, "%s_builds", label);
@@ -214,6 +244,11 @@ out:
 	case_destroy(&cb);
 	if (dir)
 		harness_remove_dir(dir);
+}
+
+static void test_resume(const char *label, const char *phases, const char *velocity_update)
+{
+	test_resume_case(label, case_json_with(phases, velocity_update, ""));
 }
 
 /* ---- refusals ---------------------------------------------------------------------------------- */
@@ -507,6 +542,8 @@ int main(int argc, char **argv)
 	test_resume("single_point_apic", "single_point", "apic");
 	test_resume("double_point_aflip", "double_point", "aflip");
 	test_resume("single_point_aflip", "single_point", "aflip");
+	test_resume_case("double_point_plate", plate_case_json("double_point"));
+	test_resume_case("single_point_plate", plate_case_json("single_point"));
 	test_refusals();
 	test_run_killed_and_resumed("double_point");
 	test_run_killed_and_resumed("single_point");

@@ -93,4 +93,81 @@ static inline double time_for_factor(double k, double Tv, double rho_w, double g
 	return Tv * rho_w * g * mv * H * H / k;
 }
 
+/* Mandel's problem (Mandel 1953; the series as written by Cheng and Detournay 1988, Eq. 27, and
+ * Abousleiman et al. 1996, Eq. 23): a layer -a < x < a, plane strain, squeezed between rigid
+ * smooth impermeable plates by a total force 2F (per metre of thickness; F on each half, a mean
+ * vertical stress F / a), its sides x = +-a drained and free of stress. The excess pore pressure is
+ *     p(x, t) = 2 p0 sum_n sin(alpha_n) / (alpha_n - sin(alpha_n) cos(alpha_n))
+ *                          (cos(alpha_n x / a) - cos(alpha_n)) exp(-alpha_n^2 c t / a^2),
+ * with alpha_n the positive roots of tan(alpha) = alpha (1 - nu) / (nu_u - nu), p0 the pressure
+ * the load raises at once, p0 = B (1 + nu_u) F / (3 a) (half the mean vertical stress for
+ * B = 1, nu_u = 1/2), and c the consolidation coefficient
+ *     c = 2 kappa B^2 G (1 - nu) (1 + nu_u)^2 / (9 (1 - nu_u) (nu_u - nu)),   kappa = k / (rho_w g).
+ * With incompressible grains and water (as in the semi-implicit scheme) B = 1 and nu_u = 1/2,
+ * tan(alpha) = 2 (1 - nu) alpha / (1 - 2 nu) and c = kappa 2 G (1 - nu) / (1 - 2 nu), which is
+ * Terzaghi's c_v = k / (rho_w g m_v) with m_v of 000 Eq. 86: a Tv = c t / a^2 here is the same
+ * time factor as Terzaghi's with a in place of H. The derivation from the 1-D equations
+ * (uniform vertical strain under the plate, sigma_xx = 0, Darcy flow to the sides) and the checks
+ * against a finite-difference solution of the same equations are in tests/verify/mandel_test.c. */
+#define MANDEL_ROOTS 200
+
+/* The first count roots of tan(alpha) = r alpha, r = (1 - nu) / (nu_u - nu) > 1: the n-th
+ * (n = 0, 1, ...) lies in (n pi, n pi + pi / 2), where tan(alpha) - r alpha rises from below 0
+ * (n = 0: from 0 with slope 1 - r < 0) to +infinity; found by bisection. */
+static inline void mandel_roots(double r, double *alpha, int count)
+{
+	for (int n = 0; n < count; n++) {
+		double lo = n * M_PI + (n == 0 ? 1e-9 : 0.0), hi = n * M_PI + 0.5 * M_PI - 1e-15 * (n + 1);
+		for (int i = 0; i < 200; i++) {
+			double mid = 0.5 * (lo + hi);
+			if (tan(mid) - r * mid < 0.0)
+				lo = mid;
+			else
+				hi = mid;
+		}
+		alpha[n] = 0.5 * (lo + hi);
+	}
+}
+
+/* p(x, Tv) / p0 for 0 <= x <= a (Tv = c t / a^2 > 0), Poisson ratios nu (drained) and nu_u
+ * (undrained), nu < nu_u. */
+static inline double mandel_pressure_ratio(double x, double a, double Tv, double nu, double nu_u)
+{
+	double alpha[MANDEL_ROOTS], sum = 0.0;
+	mandel_roots((1.0 - nu) / (nu_u - nu), alpha, MANDEL_ROOTS);
+	for (int n = 0; n < MANDEL_ROOTS; n++) {
+		double al = alpha[n], s = sin(al), co = cos(al);
+		sum += s / (al - s * co) * (cos(al * x / a) - co) * exp(-al * al * Tv);
+	}
+	return 2.0 * sum;
+}
+
+/* The same for a force that rises linearly from 0 to F over Tv_ramp, then stays (a "ramp" time
+ * function): by superposition (Duhamel) the step response averaged over the ramp,
+ * p(Tv) = (1 / Tv_ramp) int_0^min(Tv, Tv_ramp) p_step(Tv - tau) dtau, each term of the series
+ * integrated in closed form. p0 is the final load's. Tv_ramp = 0 is the step load. */
+static inline double mandel_pressure_ratio_ramped(double x, double a, double Tv, double Tv_ramp, double nu,
+						  double nu_u)
+{
+	if (!(Tv_ramp > 0.0))
+		return mandel_pressure_ratio(x, a, Tv, nu, nu_u);
+	double alpha[MANDEL_ROOTS], sum = 0.0;
+	mandel_roots((1.0 - nu) / (nu_u - nu), alpha, MANDEL_ROOTS);
+	for (int n = 0; n < MANDEL_ROOTS; n++) {
+		double al = alpha[n], s = sin(al), co = cos(al), a2 = al * al;
+		/* int over the ramp of exp(-a2 (Tv - tau)) dtau, tau in [0, min(Tv, Tv_ramp)] */
+		double in_time = Tv <= Tv_ramp ? (1.0 - exp(-a2 * Tv)) / a2
+					       : (exp(-a2 * (Tv - Tv_ramp)) - exp(-a2 * Tv)) / a2;
+		sum += s / (al - s * co) * (cos(al * x / a) - co) * in_time;
+	}
+	return 2.0 * sum / Tv_ramp;
+}
+
+/* The pressure the load raises at once, p0 = B (1 + nu_u) F / (3 a), for a force F per metre on
+ * the half width a (Pa). */
+static inline double mandel_initial_pressure(double F, double a, double B, double nu_u)
+{
+	return B * (1.0 + nu_u) * F / (3.0 * a);
+}
+
 #endif
