@@ -42,7 +42,7 @@ idx_t grid_cell_of(const struct grid *g, const double x[2])
 #define GRID_DOUBLE_FIELDS(X)                                                                  \
 	X(mass_s, 1) X(mass_w, 1) X(mass_w_points, 1) X(mass_w_v, 1) X(volume_s, 1) X(v_s, 2) X(v_w, 2)       \
 	X(v_s_old, 2) X(v_w_old, 2) X(v_s_star, 2) X(v_w_star, 2) X(porosity, 1)               \
-	X(conductivity, 1) X(drag_dt, 1) X(mobility_ratio, 1) X(pressure, 1) X(dp, 1) X(force_w, 2) X(force, 2) X(rhs, 1)         \
+	X(conductivity, 1) X(drag_dt, 1) X(mobility_ratio, 1) X(pressure, 1) X(fit_moments, 9) X(dp, 1) X(force_w, 2) X(force, 2) X(rhs, 1)         \
 	X(correction_s, 2) X(correction_w, 2) X(du_s, 2)
 
 enum poro_status grid_fields_init(struct grid_fields *f, const struct grid *g, struct poro_error *err)

@@ -38,7 +38,9 @@ struct grid_fields {
 	double *conductivity;    /* k_I, Eq. 47, m/s */
 	double *drag_dt;         /* Q_I dt, Eq. 58 times the step, kg/m: the drag of both velocity updates */
 	double *mobility_ratio;  /* mixture mobility with drag over that without (pressure.c), 1 without drag */
-	double *pressure;        /* p^t_I: water-mass-weighted projection of point pressures, tension + */
+	double *pressure;        /* p^t_I: water-mass-weighted projection of point pressures (Eq. 77's
+				    inner sum, as a local linear fit: transfer.h), tension + */
+	double *fit_moments;     /* [9 node_count] scratch of that fit (p2g_scalar_linear_fit) */
 	double *dp;              /* p^{t+1} - p^t, Eq. 60 */
 	double *force_w;         /* F_w^ext - F_w^int, Eqs. 56-57, N/m */
 	double *force;           /* F^ext - F^int of the mixture, Eqs. 54-55 */

@@ -5,6 +5,8 @@
  * per-thread grids) is a performance change that must keep these results bit-for-bit, so it lives
  * behind this same interface when it comes. Gathers are independent per point and run in parallel.
  */
+#include <string.h>
+
 #include "transfer.h"
 
 void p2g_scalar(const struct grid *g, const struct particles *p, const double *weight,
@@ -164,6 +166,51 @@ static inline double support_offsets(const double *w, int S, double h, double *d
 }
 
 #define AFFINE_D_FLOOR 1e-12   /* of h^2: below it a direction has no affine part (transfer.h) */
+
+void p2g_scalar_linear_fit(const struct grid *g, const struct particles *p, const double *weight,
+			   const double *value, double *moments, double *out)
+{
+	const int S = p->support;
+	const idx_t nx = g->nodes[0];
+	enum { W, WX, WY, WXX, WXY, WYY, WV, WVX, WVY, MOMENTS };   /* sums of w, w dx, ..., w v dy */
+	double *m = moments;
+	memset(m, 0, sizeof(double) * MOMENTS * (size_t)g->node_count);
+	for (idx_t q = 0; q < p->n; q++) {
+		const struct shape_factors f = particle_shape(p, q);
+		double dX[SHAPE_SUPPORT_MAX], dY[SHAPE_SUPPORT_MAX];   /* X_a - x_p: minus x_p - x_I */
+		support_offsets(f.wx, S, g->h, dX);
+		support_offsets(f.wy, S, g->h, dY);
+		const double wq = weight ? weight[q] : 1.0, v = value[q];
+		for (int b = 0; b < S; b++)
+			for (int a = 0; a < S; a++) {
+				double *M = m + MOMENTS * (size_t)(p->node0[q] + a + b * nx);
+				const double c = wq * (f.wx[a] * f.wy[b]), dx = -dX[a], dy = -dY[b];
+				M[W] += c, M[WX] += c * dx, M[WY] += c * dy;
+				M[WXX] += c * dx * dx, M[WXY] += c * dx * dy, M[WYY] += c * dy * dy;
+				M[WV] += c * v, M[WVX] += c * v * dx, M[WVY] += c * v * dy;
+			}
+	}
+	const double spread_min = LINEAR_FIT_SPREAD_MIN * g->h * g->h;
+	for (idx_t I = 0; I < g->node_count; I++) {
+		const double *M = m + MOMENTS * (size_t)I;
+		if (!(M[W] > 0.0))
+			continue;
+		/* centred moments: the fit's slope solves C b = c_v, and a = mean - b . centroid */
+		const double mx = M[WX] / M[W], my = M[WY] / M[W], mean = M[WV] / M[W];
+		const double cxx = M[WXX] / M[W] - mx * mx, cxy = M[WXY] / M[W] - mx * my, cyy = M[WYY] / M[W] - my * my;
+		const double cvx = M[WVX] / M[W] - mean * mx, cvy = M[WVY] / M[W] - mean * my;
+		const int fit_x = cxx > spread_min, fit_y = cyy > spread_min;
+		const double det = cxx * cyy - cxy * cxy;
+		double bx = 0.0, by = 0.0;
+		if (fit_x && fit_y && det > spread_min * spread_min)
+			bx = (cyy * cvx - cxy * cvy) / det, by = (cxx * cvy - cxy * cvx) / det;
+		else if (fit_y && !fit_x)
+			by = cvy / cyy;
+		else if (fit_x && !fit_y)
+			bx = cvx / cxx;
+		out[I] = mean - bx * mx - by * my;
+	}
+}
 
 void p2g_affine_momentum(const struct grid *g, const struct particles *p, const double *mass, const double *v,
 			 const double *C, double *out)

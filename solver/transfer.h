@@ -27,6 +27,21 @@ void p2g_vector(const struct grid *g, const struct particles *p, const double *w
 void p2g_internal_force(const struct grid *g, const struct particles *p, const double *weight,
 			const double *stress, const double *iso, double *out);
 
+/* The nodal value of a point scalar as a local linear fit: at each node I, the a_I of
+ *     min over (a_I, b_I) of sum_p S_Ip weight_p (value_p - a_I - b_I . (x_p - x_I))^2,
+ * the weighted mean sum S w v / sum S w corrected by the slope times the offset of the points'
+ * weighted centroid from the node. Where the points' centroid in a node's support is the node
+ * itself (the interior of a regular lattice) that is the mean; at walls, the free surface and
+ * where the points have moved apart the mean is the field's value at the centroid, not at the
+ * node, and only the fit passes a linear field (the hydrostatic pressure) through unchanged
+ * (docs/numerics.md, "Water at rest under gravity"). A direction in which the points of a
+ * support spread less than LINEAR_FIT_SPREAD_MIN h^2 (in variance; e.g. a node reached by one
+ * row of points) gets no slope. moments: scratch, 9 node_count doubles; out is overwritten at
+ * every node the points reach and left alone elsewhere. */
+#define LINEAR_FIT_SPREAD_MIN 1e-3
+void p2g_scalar_linear_fit(const struct grid *g, const struct particles *p, const double *weight,
+			   const double *value, double *moments, double *out);
+
 /* out_p = sum_I S_Ip node_I (Eqs. 38-40, 48). */
 void g2p_scalar(const struct grid *g, const struct particles *p, const double *node, double *out);
 
