@@ -167,10 +167,11 @@ static void map_soil_to_grid(struct sim *s)
 }
 
 /* Step 2e-f: water mass (Eq. 50), water velocity (Eq. 51) and the nodal pressure p^t, in one
- * loop over the water points (with the Laplacian, p^t then again as a linear fit). Double point first takes steps 8h-8i of the last step at each
- * point, from the nodal porosity just mapped (so they use the points' current positions): the
- * soil porosity seen by the water point (Eq. 48) and its volume V_wp = n0 / n V0 (Eq. 36).
- * Single-point water shares the soil points' porosity and volume. */
+ * loop over the water points (with the Laplacian, p^t then again as a linear fit). Double point
+ * first takes steps 8h-8i of the last step at each point, from the nodal porosity just mapped (so
+ * they use the points' current positions): the soil porosity seen by the water point (Eq. 48) and
+ * its volume V_wp = n0 / n V0 (Eq. 36). Single-point water shares the soil points' porosity and
+ * volume. */
 static void map_water_to_grid(struct sim *s)
 {
 	struct particles *w = &s->water;
