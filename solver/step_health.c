@@ -22,6 +22,11 @@ static idx_t worst_small_strain_point(const struct sim *s, double *J)
 	const struct particles *p = &s->soil;
 	idx_t worst = -1;
 	double excess = 0.0;
+	int any = 0;
+	for (int i = 0; i < s->spec->material_count; i++)
+		any |= small_strain(&s->spec->materials[i]);
+	if (!any)   /* finite-strain cases skip the loop over the points */
+		return -1;
 	for (idx_t q = 0; q < p->n; q++) {
 		if (!small_strain(&s->spec->materials[s->spec->bodies[p->body[q]].material]))
 			continue;

@@ -18,7 +18,7 @@
  *    point row reaches in the first steps (docs/numerics.md "Drag in the velocity correction").
  * Known failures, reported as XFAIL (docs/numerics.md "Stable time step"):
  *  - the low-permeability case's own formulation (weak free surface) at k = 1 m/s leaves [-q, 2 q]
- *    after about 3,500 steps;
+ *    after about 3,500 steps (with APIC velocities it stays within [-q, 1.5 q], asserted);
  *  - a soft double-point column (E = 1e6 Pa, k = 1e-3 m/s) ends at an inverted point once its
  *    expelled water reaches the empty cell above the soil, at a dt 0.09 times its CFL step.
  */
@@ -191,6 +191,14 @@ static void known_weak_surface_high_k(void)
 	       r.pmin, r.pmax, r.ok ? "" : "; failed: ", r.error);
 	CHECK_KNOWN_FAILURE(r.ok && r.pmin >= -1 && r.pmax <= 2, "sweep_weak_surface_k1_pressure_within_-q_2q",
 			    "[%.4f, %.4f] q over 4000 steps", r.pmin, r.pmax);
+	/* the cause: a row-to-row pattern of the water points' FLIP velocities, which the grid cannot
+	 * see and the drag no longer damps at this k; APIC keeps none */
+	c->formulation.velocity_update = VELOCITY_UPDATE_APIC;
+	run(c, 4000, &r);
+	printf("INFO sweep low-permeability formulation with APIC, k=1: %ld steps, pressure in [%.4f, %.4f] q%s%s\n",
+	       r.steps, r.pmin, r.pmax, r.ok ? "" : "; failed: ", r.error);
+	CHECK(r.ok && r.pmin >= P_MIN && r.pmax <= P_MAX, "sweep_weak_surface_apic_k1_pressure_within_-q_1.5q",
+	      "[%.4f, %.4f] q over 4000 steps", r.pmin, r.pmax);
 	case_destroy(&c);
 }
 
