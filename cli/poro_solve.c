@@ -182,6 +182,8 @@ static int cmd_run(const char *path, const struct run_options *opt)
 	signal(SIGTERM, on_signal);
 	signal(SIGINT, on_signal);
 	st = sim_run(s, out_dir, PORO_VERSION, print_progress, NULL, &stop_requested);
+	if (!st && sim_warning(s))   /* a failure's message quotes it already (step_health.c) */
+		printf("warning: %s\n", sim_warning(s));
 	int code = 0;
 	if (st)
 		code = fail(st, sim_error(s), path);

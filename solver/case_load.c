@@ -34,6 +34,7 @@
 #include "case_json.h"
 #include "case_material.h"
 #include "case_region.h"
+#include "stable_dt.h"
 
 /* Defaults of optional values (documented in schemas/case.schema.json and docs/case-spec.md). */
 #define DEFAULT_FLUID_DENSITY 1000.0      /* kg/m^3, water */
@@ -586,6 +587,21 @@ static int read_time(struct case_reader *r, const json_t *root, struct case_spec
 				      CASE_STEPS_MAX);
 }
 
+/* The scheme's stable step (stable_dt.h), checked once everything it follows from (grid, materials,
+ * bodies, fluid, gravity, time) was read without a problem. */
+static void check_stable_dt(struct case_reader *r, const struct case_spec *c)
+{
+	char dt[CASE_NUMBER_SIZE];
+	struct stable_dt e;
+	stable_dt_estimate(c, &e);
+	if (e.body < 0 || !(c->time.dt > stable_dt_max(&e)))
+		return;
+	case_problem(r, "/time/dt", "must be at most %.3g s, %.3g times the soil skeleton's CFL step h / c_p = %.3g s "
+		     "(c_p = sqrt((K + 4G/3) / ((1 - n) rho_s)) = %.4g m/s in body '%s'), got %s",
+		     stable_dt_max(&e), STABLE_DT_MAX_FACTOR, e.cfl, e.wave_speed, c->bodies[e.body].name,
+		     case_format_number(dt, c->time.dt));
+}
+
 /* How many times something due every interval of simulated time happens in a run: at most once a
  * step (run.c), whatever the interval. */
 static double events_in_run(const struct case_spec *c, double interval)
@@ -719,6 +735,8 @@ static void read_case(struct case_reader *r, const json_t *root, struct case_spe
 	read_output(r, root, c, time_ok);
 	read_probes(r, root, c, grid_ok);
 	read_checkpoint(r, root, c, time_ok);
+	if (!r->problem_count && time_ok)
+		check_stable_dt(r, c);
 }
 
 /* Reads the document root into a new case; its JSON text is text, or root in canonical form when

@@ -34,6 +34,9 @@ double sim_time(const struct sim *s);
 long sim_steps_taken(const struct sim *s);
 long sim_steps_total(const struct sim *s);
 const struct poro_error *sim_error(const struct sim *s);
+/* The first warning the run raised (a small-strain model far outside its validity, step_health.c),
+ * or NULL. A warning does not stop the run; drivers print it in the run's log. */
+const char *sim_warning(const struct sim *s);
 
 /* Point sets. The water set is the double-point water points, or for single point the water
  * phase riding on the soil points (positions shared with the soil set). */

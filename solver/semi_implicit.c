@@ -586,9 +586,10 @@ static enum poro_status update_soil_kinematics(struct sim *s)
 	}
 	if (bad >= 0)
 		return poro_error_set(&s->err, PORO_ESOLVER, "soil point %ld at (%.6g, %.6g) m: volume ratio %.6g "
-				      "gives porosity outside (0, 1) or an inverted point at step %ld",
+				      "gives porosity outside (0, 1) or an inverted point at step %ld (J must stay "
+				      "above 1 - n0 = %.6g, where the pores close)",
 				      (long)bad, p->x[2 * bad], p->x[2 * bad + 1], p->volume[bad] / p->volume0[bad],
-				      s->step + 1);
+				      s->step + 1, 1.0 - p->porosity0[bad]);
 	return PORO_OK;
 }
 

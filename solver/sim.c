@@ -15,6 +15,7 @@
 
 #include "shape.h"
 #include "sim_internal.h"
+#include "step_health.h"
 
 /* A seed point closer to a polygon edge than this many cell sizes lies on the edge: it is not
  * inside. Seeds fall exactly on 45-degree faces whenever the face runs through sub-cell centres
@@ -199,6 +200,7 @@ enum poro_status sim_create(struct sim **out, const struct case_spec *c, struct 
 	s->dt = c->time.dt;
 	s->steps_total = (long)ceil(c->time.end / c->time.dt - 1e-9);
 	s->rho_w = c->fluid.density;
+	stable_dt_estimate(c, &s->stable);
 	enum poro_status st = build(s);
 	if (st) {
 		if (err)
@@ -236,11 +238,9 @@ void sim_destroy(struct sim **ps)
 	*ps = NULL;
 }
 
-enum poro_status sim_step(struct sim *s)
+/* The checks a finished step's state must pass; 0 when it passes. */
+static enum poro_status check_finite(struct sim *s)
 {
-	enum poro_status st = semi_implicit_step(s);
-	if (st)
-		return st;
 	const struct particles *p = &s->soil;
 	for (idx_t q = 0; q < p->n; q++)      /* NaN anywhere in a step surfaces in these */
 		if (!isfinite(p->v[2 * q] + p->v[2 * q + 1] + p->stress[4 * q] + p->stress[4 * q + 1] + p->stress[4 * q + 2]))
@@ -253,6 +253,18 @@ enum poro_status sim_step(struct sim *s)
 					      "non-finite pressure or velocity at step %ld (t = %.6g s)", (long)q,
 					      s->water.x[2 * q], s->water.x[2 * q + 1], s->step, s->time);
 	return PORO_OK;
+}
+
+enum poro_status sim_step(struct sim *s)
+{
+	enum poro_status st = semi_implicit_step(s);
+	if (!st)
+		st = check_finite(s);
+	if (st == PORO_ESOLVER)   /* the symptom is named; add what it likely follows from */
+		step_health_explain(s);
+	if (!st)
+		step_health_watch(s);
+	return st;
 }
 
 double sim_clock(void)
@@ -280,6 +292,7 @@ double sim_time(const struct sim *s) { return s->time; }
 long sim_steps_taken(const struct sim *s) { return s->step; }
 long sim_steps_total(const struct sim *s) { return s->steps_total; }
 const struct poro_error *sim_error(const struct sim *s) { return &s->err; }
+const char *sim_warning(const struct sim *s) { return s->warning[0] ? s->warning : NULL; }
 const struct particles *sim_soil(const struct sim *s) { return &s->soil; }
 const struct particles *sim_water(const struct sim *s) { return &s->water; }
 int sim_is_double_point(const struct sim *s) { return s->double_point; }

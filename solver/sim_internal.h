@@ -12,6 +12,7 @@
 #include "material.h"
 #include "poro.h"
 #include "spd_solve.h"
+#include "stable_dt.h"
 
 /* Standard gravity in the drag term n^2 rho_w g / k (000 Eq. 15): hydraulic conductivity is
  * defined with it, so it stays 9.81 m/s^2 even when a case switches the body force off. */
@@ -55,6 +56,8 @@ struct sim {
 	long step, steps_total;
 	double rho_w;                 /* fluid density, kg/m^3 */
 	double gravity[2];            /* body force b^{t+1} of the current step, m/s^2 */
+	struct stable_dt stable;      /* the scheme's CFL step for this case (stable_dt.h) */
+	char warning[512];            /* the run's first warning (step_health.c), "" if none */
 
 	/* per-point scratch, sized at create */
 	double *soil_grad;            /* [4 n_soil] velocity or displacement gradient */

@@ -61,6 +61,14 @@ bad_input unknown_key "/time/dtt"
 bad_input body_outside_grid "/bodies/0"
 bad_input missing_material "/bodies/0/material"
 
+# ---- a dt a few times the skeleton's CFL step (solver/stable_dt.c) is refused with the bound -------
+
+derive dt_above_cfl 'c["time"]["dt"] = 2e-3'
+bad_input dt_above_cfl "/time/dt"
+"$solve" validate "$tmp/dt_above_cfl.json" > /dev/null 2> "$tmp/err"
+grep -q "^/time/dt: must be at most 0.000426 s, 1.25 times the soil skeleton's CFL step h / c_p = 0.00034 s" "$tmp/err"
+check validate_names_the_stable_dt $? "stderr: $(head -c 300 "$tmp/err")"
+
 # ---- limits of a case (docs/case-spec.md "Limits"): the issue's 1.6e9 cells and end time of 1e12 s ----
 
 derive too_many_cells 'c["grid"]["extent"] = [1000.0, 1000.0]'

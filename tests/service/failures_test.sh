@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
 # failures_test.sh - how jobs fail, with a real poro-server, poro-worker and poro-solve:
-#   - a solver failure (a case that passes validation but blows up: dt far above the soil's
-#     stable step) is final: state failed after one attempt, never retried, with the solver's own
-#     message (which point, where, why) kept on the job;
+#   - a solver failure (a case that passes validation but blows up: a soil too soft for its load,
+#     E = 1e5 Pa under q = 10 kPa; a dt far above the soil's stable step is refused by validation
+#     since solver/stable_dt.c) is final: state failed after one attempt, never retried, with the
+#     solver's own message (which point, where, why) kept on the job;
 #   - a job over its wall-time limit is stopped by the worker and fails with a message saying so,
 #     its solver gone, not retried;
 #   - a job that needs more memory than the worker's --memory-limit-mb fails, final, saying so;
@@ -28,7 +29,7 @@ worker=$!
 python3 - tests/cases/terzaghi.json "$SVC_TMP" <<'EOF'
 import json, sys
 c = json.load(open(sys.argv[1]))
-blow = dict(c, time={"dt": 0.05, "end": 20.0})
+blow = dict(c, materials=[dict(c["materials"][0], youngs_modulus=1e5)], time={"dt": 1e-3, "end": 20.0})
 json.dump({"case": blow}, open(sys.argv[2] + "/blow.json", "w"))
 json.dump({"case": c, "wall_time_seconds": 3, "threads": 2}, open(sys.argv[2] + "/slow.json", "w"))
 huge = dict(c, grid=dict(c["grid"], extent=[100.0, 100.0]))   # 16 million nodes

@@ -12,6 +12,7 @@
  */
 #include "case.h"
 #include "element.h"
+#include "stable_dt.h"
 
 #include <glob.h>
 #include <jansson.h>
@@ -733,6 +734,61 @@ static void test_plate(void)
 	expect_invalid_edits("plate object on a face without a plate", full_case, stray, 1, needles);
 }
 
+/* The skeleton's CFL step (solver/stable_dt.c): a dt above STABLE_DT_MAX_FACTOR times it is refused
+ * with the bound in the message, a dt below it loads, and the check waits for the rest of the case
+ * to be right. The full case's stiffest body is 'base': E = 1e7 Pa, nu = 0, n = 0.3, rho_s = 2650
+ * kg/m^3, h = 0.1 m, so c_p = sqrt(1e7 / 1855) m/s. */
+static void test_stable_dt(const char *root)
+{
+	const double c_p = sqrt(1e7 / ((1 - 0.3) * 2650)), cfl = 0.1 / c_p;
+	char needle[400], dt_text[32];
+	snprintf(needle, sizeof needle, "/time/dt: must be at most %.3g s, %.3g times the soil skeleton's CFL step "
+		 "h / c_p = %.3g s (c_p = sqrt((K + 4G/3) / ((1 - n) rho_s)) = %.4g m/s in body 'base'), got 0.005",
+		 STABLE_DT_MAX_FACTOR * cfl, STABLE_DT_MAX_FACTOR, cfl, c_p);
+	expect_invalid("dt a few times the CFL step", "/time/dt", "0.005", needle);
+	snprintf(dt_text, sizeof dt_text, "%.6g", 0.95 * STABLE_DT_MAX_FACTOR * cfl);
+	{
+		const struct edit e = { "/time/dt", dt_text };
+		char *text = edited(full_case, &e, 1);
+		struct case_spec *c = load_valid("dt just below the refusal bound loads", text);
+		case_destroy(&c);
+		free(text);
+	}
+	{
+		/* one mistake, one line: a bad Poisson ratio leaves the bound (which follows from it) unchecked */
+		const struct edit e[] = { { "/time/dt", "0.005" }, { "/materials/0/poisson_ratio", "0.7" } };
+		char *text = edited(full_case, e, 2);
+		struct case_spec *c = NULL;
+		struct poro_error err = { 0 };
+		enum poro_status st = case_load_string(text, &c, &err);
+		CHECK(st == PORO_EINVAL && !strstr(err.message, "/time/dt") && strstr(err.message, "poisson_ratio"),
+		      "dt bound not checked on a case with other problems", "%s", err.message);
+		free(text);
+	}
+	/* Nor-Sand: K = p / kappa at the buoyant weight of the body's height, plus 4G/3 */
+	char path[512];
+	snprintf(path, sizeof path, "%stests/cases/landslide_dense_double_point.json", root);
+	struct case_spec *c = NULL;
+	struct poro_error err = { 0 };
+	if (case_load_file(path, &c, &err) == PORO_OK) {
+		struct stable_dt e;
+		stable_dt_estimate(c, &e);
+		const struct case_body *b = &c->bodies[0];
+		const struct case_material *m = &c->materials[b->material];
+		const double p = (1 - b->porosity) * (m->density - c->fluid.density) * 9.81 * (b->max[1] - b->min[1]);
+		const double M = fmax(p, m->initial_reference_pressure) / m->swelling_index + 4.0 / 3.0 * m->shear_modulus;
+		CHECK(e.body == 0 && rel_diff(e.modulus, M, 1) < 1e-9 &&
+		      rel_diff(e.cfl, c->grid.cell_size / sqrt(M / ((1 - b->porosity) * m->density)), 1e-30) < 1e-9,
+		      "nor-sand CFL step from p / kappa + 4G/3", "modulus %.6g against %.6g, cfl %.6g", e.modulus, M,
+		      e.cfl);
+		CHECK(c->time.dt < stable_dt_max(&e), "the dense landslide's dt is below the bound", "dt %.6g, bound %.6g",
+		      c->time.dt, stable_dt_max(&e));
+	} else {
+		CHECK(0, "nor-sand CFL step from p / kappa + 4G/3", "%s", err.message);
+	}
+	case_destroy(&c);
+}
+
 int main(void)
 {
 	char root[256];
@@ -752,5 +808,6 @@ int main(void)
 	test_unreadable_file();
 	test_shipped_cases(root);
 	test_documented_example(root);
+	test_stable_dt(root);
 	HARNESS_EXIT();
 }
