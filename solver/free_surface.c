@@ -20,7 +20,10 @@
  *
  * How p = 0 is held there.
  *  - "nodes" (default, the paper's step 5b): every node next to a cell that is not full gets
- *    p^{t+1} = 0, as do the nodes of drained faces.
+ *    p^{t+1} = 0, as do the nodes of drained faces. With the Laplacian a cell is full only at
+ *    FREE_SURFACE_FILL_NODES_LAPLACIAN: a cell counted full at a half puts p = 0 half a cell
+ *    beyond the surface, and the column under it diverged (docs/numerics.md, "Columns whose top
+ *    cuts a cell").
  *  - "interpolated" (consistent projection only): the nodes on a face between a full cell and a
  *    dry one become unknowns, and the interpolated pressure sum_J S_J(x) p^{t+1}_J is driven to
  *    zero at points x on the surface by a penalty in the energy the projection minimises,
@@ -66,6 +69,17 @@
 
 /* A cell is full (below the free surface) when its points' volumes reach this fraction of it. */
 #define FREE_SURFACE_FILL 0.5
+/* The same under the nodal condition with the Laplacian (000 Eq. 61): there a full cell next to a
+ * dry one puts p = 0 on nodes (1 - f) h beyond the surface of a cell filled to f, and the pressure
+ * field keeps a share of the interior pressure at the surface that the pressure force does not
+ * see (quadratic B-splines: (1.5 - f)^2 / 2, an eighth at f = 1, a half at f = 1/2); the interior
+ * rises until the part it sees carries the load, and the Laplacian, which over-corrects short
+ * waves, amplifies that rise step after step. Measured on a column whose top fills its cell to f
+ * (docs/numerics.md, "Columns whose top cuts a cell"): counted full at f = 1/2 and 3/4 it
+ * diverges (interior 3.7 q after one step), at f = 0.8 on the softer columns tried; at 0.85 to 1
+ * it stays within 1.2-1.47 q. Counted not full, the cell's lower nodes take p = 0, f h inside the
+ * surface: a drained skin, whose error the threshold keeps below 0.9 h. */
+#define FREE_SURFACE_FILL_NODES_LAPLACIAN 0.9
 /* The weak condition's boundary term acts on a node's phase only where that phase's nodal mass
  * reaches this fraction of the largest: a surface point may lie beyond the points' reach, and its
  * push on a node they barely touch would be divided by a mass near zero. */
@@ -98,7 +112,10 @@ static void mark_full_cells(struct sim *s)
 {
 	const struct grid *g = &s->grid;
 	struct grid_fields *f = &s->f;
-	const double full = FREE_SURFACE_FILL * g->h * g->h;
+	const struct case_formulation *form = &s->spec->formulation;
+	const int nodes_laplacian = form->free_surface == FREE_SURFACE_NODES &&
+				    form->pressure_projection == PROJECTION_LAPLACIAN;
+	const double full = (nodes_laplacian ? FREE_SURFACE_FILL_NODES_LAPLACIAN : FREE_SURFACE_FILL) * g->h * g->h;
 	cell_volumes(g, &s->water, s->cell_fill);
 	for (idx_t c = 0; c < g->cell_count; c++)
 		f->cell_wet[c] = s->cell_fill[c] >= full;

@@ -36,8 +36,9 @@
  *
  * At the point faces (thinner bodies: there phi would fall to 0 within a few cells, and the
  * smeared part S_I N . grad phi would outweigh the part that balances the stress). Each loaded
- * point carries its share of the face, N dA = outward normal times the point spacing
- * h / particles_per_cell, in the reference configuration; the current share follows Nanson's
+ * point carries its share of the face, N dA = outward normal times the point's width along the
+ * face (h / particles_per_cell, or its volume over its thickness where the face cuts its row), in
+ * the reference configuration; the current share follows Nanson's
  * formula da = J F^-T N dA, so the load keeps acting on the material face as it deforms. It is
  * applied at the face midpoint, centre + F N d / 2: mapping it at the centre gives the nodes
  * beyond the surface a quarter of the load their share of the stress divergence asks for, and
@@ -61,7 +62,11 @@ void loads_init(struct sim *s)
 	for (int l = 0; l < c->load_count; l++) {
 		const struct case_load *load = &c->loads[l];
 		const struct case_body *body = &c->bodies[load->body];
+		/* a rectangle's outermost row has its centres within 3/4 of a spacing of the face (a
+		 * row the face cuts is 1/2 to 3/2 spacings thick, sim.c), the next row a spacing or
+		 * more; a polygon's points keep the sub-grid, its outermost row within a spacing */
 		const double spacing = h / body->particles_per_cell;
+		const double outermost = body->is_polygon ? spacing : 0.875 * spacing;
 		struct load_band *band = &s->load_bands[l];
 		const int axis = band->axis = (load->face == FACE_LEFT || load->face == FACE_RIGHT) ? 0 : 1;
 		const int upper = load->face == FACE_RIGHT || load->face == FACE_TOP;
@@ -74,14 +79,18 @@ void loads_init(struct sim *s)
 			if (p->body[q] != load->body)
 				continue;
 			double normal_coord = p->x0[2 * q + axis], along = p->x0[2 * q + 1 - axis];
-			if (fabs(normal_coord - band->face) >= spacing || along < load->from || along > load->to)
+			if (fabs(normal_coord - band->face) >= outermost || along < load->from || along > load->to)
 				continue;
+			/* a rectangle's point reaches from its centre to the face: its share of the face
+			 * is its volume over that thickness (one spacing, unless the face cuts its row) */
+			const double thickness = body->is_polygon ? spacing : 2.0 * fabs(band->face - normal_coord);
+			const double width = p->volume0[q] / thickness;
 			p->surface_load[q] = l;
-			p->surface[2 * q + axis] = band->sign * spacing;
+			p->surface[2 * q + axis] = band->sign * width;
 			p->surface[2 * q + 1 - axis] = 0.0;
-			/* the strip under a loaded point is its column of points, spacing wide */
-			band->along[0] = fmin(band->along[0], along - 0.5 * spacing);
-			band->along[1] = fmax(band->along[1], along + 0.5 * spacing);
+			/* the strip under a loaded point is its column of points, as wide as its share */
+			band->along[0] = fmin(band->along[0], along - 0.5 * width);
+			band->along[1] = fmax(band->along[1], along + 0.5 * width);
 		}
 	}
 }
@@ -99,9 +108,11 @@ static void add_at_faces(struct sim *s, int l, double scale, double *force)
 		const double *F = p->F + 4 * q, *N = p->surface + 2 * q;
 		/* J F^-T N in 2-D: [[F11, -F10], [-F01, F00]] N */
 		double area = hypot(F[3] * N[0] - F[2] * N[1], -F[1] * N[0] + F[0] * N[1]);
-		/* N has length d, so F N / 2 reaches from the centre to the face */
-		double face[2] = {p->x[2 * q] + 0.5 * (F[0] * N[0] + F[1] * N[1]),
-				  p->x[2 * q + 1] + 0.5 * (F[2] * N[0] + F[3] * N[1])};
+		/* N has the length of the point's share of the face, V0 / |N| its thickness, so
+		 * F N V0 / (2 |N|^2) reaches from the centre to the face */
+		const double reach = 0.5 * p->volume0[q] / (N[0] * N[0] + N[1] * N[1]);
+		double face[2] = { p->x[2 * q] + reach * (F[0] * N[0] + F[1] * N[1]),
+				   p->x[2 * q + 1] + reach * (F[2] * N[0] + F[3] * N[1]) };
 		double w[SHAPE_NODES_MAX];
 		idx_t node0;
 		if (shape_weights_at(&s->grid, c->formulation.shape, face, &node0, w))

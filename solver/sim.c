@@ -5,6 +5,13 @@
  * Material points are seeded on a regular sub-grid: particles_per_cell^2 points per cell at the
  * centres of equal sub-cells, kept when strictly inside the body (not on a polygon edge; a point
  * already inside an earlier body belongs to that one). Each point gets the volume of its sub-cell.
+ * A rectangle fills its own extent exactly, wherever its sides lie: a sub-cell that a side cuts
+ * gets one point at the centre of its covered part with that part's volume, and a covered part
+ * thinner than half a sub-cell joins its inner neighbour's point instead, so the rows cut by a
+ * side are 1/2 to 3/2 sub-cells thick. Keeping only the sub-cells whose centres lie inside left
+ * the points short of the side by up to a sub-cell (and a centre on the side itself was kept or
+ * dropped by round-off), while the load and the free surface took the side where the case puts it
+ * (docs/numerics.md, "Columns whose top cuts a cell").
  * Double point seeds one water point on every soil point (000 §5.1: "640 material points in total
  * for both water and soil").
  */
@@ -53,6 +60,47 @@ static int inside_body(const struct case_body *b, double x, double y, double h)
 	return b->is_polygon ? inside_polygon(b, x, y, SEED_EDGE_TOLERANCE * h) : 1;
 }
 
+/* The part of sub-cell [a, a + d] that the interval [lo, hi] of a rectangle covers, with the
+ * slivers of its neighbours that are thinner than d / 2 joined to it (file comment): 1 and the
+ * part's centre and width; 2 and width d for the whole sub-cell; 0 when the sub-cell takes no
+ * point. A side within `eps` of a sub-cell face counts as on it, so that a rectangle on the
+ * sub-grid is seeded as before, centre for centre. */
+static int covered_part(double a, double d, double lo, double hi, double eps, double *centre, double *width)
+{
+	const double b = a + d;
+	/* a neighbour keeps its own point when it is covered at least d / 2 - eps: the same test
+	 * decides here whether its part joins this one, so no part is counted twice */
+	const double from = fabs(lo - a) <= eps ? a : lo > a - 0.5 * d + eps ? lo : a;
+	const double to = fabs(hi - b) <= eps ? b : hi < b + 0.5 * d - eps ? hi : b;
+	if (fmin(b, to) - fmax(a, from) < 0.5 * d - eps)
+		return 0; /* outside, or a sliver its neighbour takes */
+	if (from == a && to == b) {
+		*width = d;
+		return 2; /* the whole sub-cell: its centre as the caller has it */
+	}
+	*centre = 0.5 * (from + to), *width = to - from;
+	return 1;
+}
+
+/* Whether the seed of sub-cell (x, y), d wide, puts a point into body b: 1 with the point's centre
+ * in (x, y) and its width and height in wx, wy (file comment; d for a whole sub-cell), else 0. */
+static int seed_in_body(const struct case_body *b, double d, double h, double *x, double *y, double *wx, double *wy)
+{
+	if (b->is_polygon)
+		return inside_body(b, *x, *y, h);
+	const double eps = SEED_EDGE_TOLERANCE * h;
+	double cx, cy;
+	int kx = covered_part(*x - 0.5 * d, d, b->min[0], b->max[0], eps, &cx, wx);
+	int ky = covered_part(*y - 0.5 * d, d, b->min[1], b->max[1], eps, &cy, wy);
+	if (!kx || !ky)
+		return 0;
+	if (kx == 1)
+		*x = cx;
+	if (ky == 1)
+		*y = cy;
+	return 1;
+}
+
 /* Visits every seed point: fills p when it is not NULL; returns the count. */
 static idx_t seed_points(const struct sim *s, struct particles *p)
 {
@@ -69,7 +117,8 @@ static idx_t seed_points(const struct sim *s, struct particles *p)
 					for (int si = 0; si < ppc; si++) {
 						double x = g->origin[0] + ci * g->h + (si + 0.5) * d;
 						double y = g->origin[1] + cj * g->h + (sj + 0.5) * d;
-						if (!inside_body(body, x, y, g->h))
+						double wx = d, wy = d;
+						if (!seed_in_body(body, d, g->h, &x, &y, &wx, &wy))
 							continue;
 						int taken = 0;
 						for (int e = 0; e < b && !taken; e++)
@@ -79,7 +128,7 @@ static idx_t seed_points(const struct sim *s, struct particles *p)
 						if (p) {
 							p->x[2 * count] = p->x0[2 * count] = x;
 							p->x[2 * count + 1] = p->x0[2 * count + 1] = y;
-							p->volume[count] = p->volume0[count] = d * d;
+							p->volume[count] = p->volume0[count] = wx * wy;
 							p->body[count] = b;
 						}
 						count++;

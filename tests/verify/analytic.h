@@ -53,6 +53,29 @@ static inline double consolidation_degree(double Tv)
 	return 1.0 - sum;
 }
 
+/* Terzaghi settlement, m, of the soil at reference height y0 of a column of height H on its base
+ * (load q, compressibility m_v): u(y0) = m_v int_0^y0 (q - p) dy, with p the series above at depth
+ * z = H - y (drained at the top, drainage length H) or z = min(H - y, y) (drained at both ends,
+ * drainage length H/2). Each term integrates in closed form, since cos M = 0:
+ *     top only:  int_0^y0 sin(M (H - y) / H) dy = (H / M) cos(M (H - y0) / H),
+ *     both ends: the same with H/2, plus (H/2) / M for the lower half (y0 >= H/2).
+ * At y0 = H it is m_v q H U(Tv). */
+static inline double terzaghi_settlement(double y0, double H, double Tv, double q, double mv, int drained_both)
+{
+	double Hd = drained_both ? H / 2 : H, integral = 0.0;
+	for (int m = 0; m < ANALYTIC_TERMS; m++) {
+		double M = (m + 0.5) * M_PI, part;
+		if (!drained_both)
+			part = cos(M * (H - y0) / H);
+		else if (y0 >= Hd)
+			part = 1.0 + cos(M * (H - y0) / Hd);
+		else
+			part = 1.0 - cos(M * y0 / Hd);
+		integral += 2.0 / M * exp(-M * M * Tv) * Hd / M * part;
+	}
+	return mv * q * (y0 - integral);
+}
+
 /* Tv at which the degree of consolidation is U, 0 < U < 1 (bisection on the monotone U(Tv)). */
 static inline double time_factor_for_degree(double U)
 {
