@@ -24,7 +24,10 @@
  * inside the grid (the grid 1.1 m high, as terzaghi.json's), where the node one cell beyond the
  * surface keeps moving, in the default formulation at about k / n, at the weak condition's ghost
  * node at a tenth of that (docs/numerics.md, "Water at rest under gravity"): a known failure of
- * the velocity check; the pressure and stress are printed.
+ * the velocity check; the pressure and stress are printed. The free surface inside the grid runs
+ * once more with APIC point velocities (double point; the cases name FLIP), asserted in full: the
+ * low-permeability formulation then comes to rest (6.9e-8 m/s), the default one still moves
+ * (1.1e-3 m/s, a known failure; docs/numerics.md, "Default point velocities: FLIP against APIC").
  * Before the linear-fit nodal pressure (transfer.h) the default formulation's pressure near the
  * base fell 0.95% (k = 1e-3) and 4.1% (k = 1e-9) below hydrostatic within the run, and its
  * effective stress took up 3.4% (k = 1e-9).
@@ -116,8 +119,8 @@ static void measure_state(const struct sim *s, double H, double K0, double *p, d
 }
 
 /* low_k: the formulation of LOW_K_FILE; free_surface: the grid 1.1 m high, the top a free water
- * surface inside it. */
-static struct rest_run run_column(enum case_phases phases, int low_k, double k, int free_surface)
+ * surface inside it; apic: APIC point velocities instead of the cases' FLIP. */
+static struct rest_run run_column(enum case_phases phases, int low_k, double k, int free_surface, int apic)
 {
 	struct rest_run r = {0};
 	struct case_spec *c = NULL, *formulation = NULL;
@@ -128,6 +131,8 @@ static struct rest_run run_column(enum case_phases phases, int low_k, double k, 
 		if (low_k)
 			c->formulation = formulation->formulation;
 		c->formulation.phases = phases;
+		if (apic)
+			c->formulation.velocity_update = VELOCITY_UPDATE_APIC;
 		c->bodies[0].hydraulic_conductivity = k;
 		if (free_surface) {
 			c->grid.extent[1] = 1.1;
@@ -176,18 +181,23 @@ int main(void)
 	for (int surface = 0; surface < 2; surface++)
 		for (int low_k = 0; low_k < 2; low_k++)
 			for (int phase = 0; phase < 2; phase++)
-				for (int ik = 0; ik < 2; ik++) {
+				for (int ik = 0; ik < 2; ik++)
+				for (int apic = 0; apic < 2; apic++) {
 					/* the free surface inside the grid at k = 1e-3 only: at 1e-9 the default
-					 * formulation's top layer grows unstable (docs/numerics.md) */
-					if (surface && ik)
+					 * formulation's top layer grows unstable (docs/numerics.md); APIC point
+					 * velocities (the cases' are FLIP) there only, double point */
+					if ((surface && ik) || (apic && (!surface || phase)))
 						continue;
 					const enum case_phases ph = phase ? PHASES_SINGLE_POINT : PHASES_DOUBLE_POINT;
 					char name[160];
 					const char *label_phase = phase ? "single_point" : "double_point";
-					const char *label_form = low_k ? "low_permeability_options" : "default_options";
+					static const char *const forms[2][2] = {
+						{"default_options", "default_options_apic"},
+						{"low_permeability_options", "low_permeability_options_apic"}};
+					const char *label_form = forms[low_k][apic];
 					const char *label_top = surface ? "free_surface_in_grid" : "drained_top";
 					double t0 = harness_wall_seconds();
-					struct rest_run r = run_column(ph, low_k, ks[ik], surface);
+					struct rest_run r = run_column(ph, low_k, ks[ik], surface, apic);
 					printf("INFO hydrostatic column %s %s %s k=%g: pressure %.5f of rho_w g d (deeper than %g cells), "
 					       "%.5f of rho_w g H (all points); effective stress %.5f of geostatic; largest nodal "
 					       "speed %.2e m/s first tenth, %.2e last tenth (allowed %.2e); %.2f s\n",
@@ -199,7 +209,7 @@ int main(void)
 					const size_t room = sizeof name - strlen(name);
 					snprintf(tail, room, "runs");
 					CHECK(r.ok, name, "run failed");
-					if (surface) {
+					if (surface && !apic) {
 						/* known: the water beyond a free surface inside the grid (file comment);
 						 * pressure and stress are on the INFO line */
 						snprintf(tail, room, "at_rest");
@@ -214,8 +224,15 @@ int main(void)
 					snprintf(tail, room, "effective_stress_geostatic");
 					CHECK(r.ok && r.stress < STRESS_TOLERANCE, name, "%.5f of geostatic", r.stress);
 					snprintf(tail, room, "at_rest");
-					CHECK(r.ok && r.v_late < r.v_allowed, name,
-					      "largest nodal speed %.2e m/s over the last tenth, allowed %.2e", r.v_late, r.v_allowed);
+					/* APIC slows the default formulation's surface node but does not stop it */
+					if (surface && !low_k)
+						CHECK_KNOWN_FAILURE(r.ok && r.v_late < r.v_allowed, name,
+								    "largest nodal speed %.2e m/s over the last tenth, allowed %.2e",
+								    r.v_late, r.v_allowed);
+					else
+						CHECK(r.ok && r.v_late < r.v_allowed, name,
+						      "largest nodal speed %.2e m/s over the last tenth, allowed %.2e", r.v_late,
+						      r.v_allowed);
 				}
 	HARNESS_EXIT();
 }
