@@ -34,9 +34,10 @@
  * B-splines' edge treatment it does not interpolate at the edge (a point whose domain touches the
  * wall gives the edge node less than 1). Locations that are not material points (surface
  * quadrature points) have no domain and get the linear hat, GIMP's zero-width limit.
- * The case loader does not offer it yet: under the semi-implicit scheme the double-point Terzaghi
- * column with uGIMP is within 0.49% RMS of q at Tv = 1, but the single-point one inverts its corner
- * point (1/4 cell from two walls) at step 45, which needs its cause found first.
+ * The case loader does not offer it yet: clipped at a wall, the domains put a quarter of the
+ * wall's reaction on the node next to the wall node, which no wall condition holds (measured under
+ * a uniform stress; docs/numerics.md, "Shape functions at the grid edges"), and the single-point
+ * Terzaghi column inverts its corner point at step 45.
  */
 #ifndef PORO_SHAPE_H
 #define PORO_SHAPE_H
