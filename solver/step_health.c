@@ -7,16 +7,12 @@
 #include <math.h>
 #include <stdio.h>
 
+#include "material.h"
 #include "stable_dt.h"
 
-/* The model computes its stress from the small-strain increment sym(dF) - I without the finite
- * kinematics of 000 Eqs. 69-76 (case.h: linear_elastic, or a plastic model with strain "small"). */
-static int small_strain(const struct case_material *m)
-{
-	return m->model == MODEL_LINEAR_ELASTIC || (m->model != MODEL_HENCKY && m->strain == STRAIN_SMALL);
-}
-
-/* The soil point of a small-strain material whose |J - 1| is largest, -1 if none; *J its J. */
+/* The soil point of a small-strain material (one whose stress comes from the small-strain
+ * increment without the finite kinematics of 000 Eqs. 69-76, material.h) whose |J - 1| is
+ * largest, -1 if none; *J its J. */
 static idx_t worst_small_strain_point(const struct sim *s, double *J)
 {
 	const struct particles *p = &s->soil;
@@ -24,11 +20,11 @@ static idx_t worst_small_strain_point(const struct sim *s, double *J)
 	double excess = 0.0;
 	int any = 0;
 	for (int i = 0; i < s->spec->material_count; i++)
-		any |= small_strain(&s->spec->materials[i]);
+		any |= !material_is_finite_strain(&s->materials[i]);
 	if (!any)   /* finite-strain cases skip the loop over the points */
 		return -1;
 	for (idx_t q = 0; q < p->n; q++) {
-		if (!small_strain(&s->spec->materials[s->spec->bodies[p->body[q]].material]))
+		if (material_is_finite_strain(&s->materials[s->spec->bodies[p->body[q]].material]))
 			continue;
 		const double Jq = p->volume[q] / p->volume0[q];
 		if (fabs(Jq - 1.0) > excess)
