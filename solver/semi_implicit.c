@@ -178,8 +178,9 @@ static void map_water_to_grid(struct sim *s)
 	struct grid_fields *f = &s->f;
 	const idx_t nodes = s->grid.node_count;
 	const int affine = affine_velocities(s);
+	const int mean_pressure = s->ps.exact;   /* the Laplacian fits p^t after the loop instead */
 	const struct p2g_batch b = {
-		.scalars = 3,
+		.scalars = mean_pressure ? 3 : 2,
 		.scalar = {{NULL, w->volume, f->mass_w_v}, {NULL, w->mass, f->mass_w_points},
 			   {w->mass, w->pressure, f->pressure}},
 		.vector = {w->mass, w->v, affine ? NULL : f->v_w},   /* the affine momentum: map_momentum */
@@ -198,7 +199,6 @@ static void map_water_to_grid(struct sim *s)
 	if (affine)
 		map_momentum(s, w, f->v_w);
 	normalise(nodes, f->v_w, 2, f->mass_w_points);
-	normalise(nodes, f->pressure, 1, f->mass_w_points);
 	/* With the Laplacian, p^{t+1} = p^t + dp and the solve removes only the part of an error in
 	 * p^t that drives a divergence, so Eq. 77's mass-weighted mean, which is the field's value at
 	 * the points' centroid rather than at the node where the points lie to one side (walls, the
@@ -206,7 +206,9 @@ static void map_water_to_grid(struct sim *s)
 	 * base after 2 s. Its linear fit is exact for the hydrostatic field and equals the mean inside
 	 * a regular lattice. The consistent projection solves for p^{t+1} itself, so the bias drops
 	 * out there and the mean stays (docs/numerics.md, "Water at rest under gravity"). */
-	if (!s->ps.exact)
+	if (mean_pressure)
+		normalise(nodes, f->pressure, 1, f->mass_w_points);
+	else   /* nodes no water point reaches keep reset_grid's 0, as the mean gives them */
 		p2g_scalar_linear_fit(&s->grid, w, w->mass, w->pressure, f->fit_moments, f->pressure);
 	for (idx_t I = 0; I < nodes; I++)   /* Eq. 50: grid porosity times sum S rho_w V_wp */
 		f->mass_w[I] = f->porosity[I] * s->rho_w * f->mass_w_v[I];
