@@ -14,13 +14,19 @@ WARN    = -Wall -Wextra -Wshadow -Wno-unused-parameter $(if $(CI),-Werror)
 SANITIZERS = -fsanitize=address,undefined -fno-omit-frame-pointer
 SANFLAGS = $(if $(SAN),$(SANITIZERS))
 PKGS    = jansson hdf5
-CPPFLAGS = -D_POSIX_C_SOURCE=200809L -DPORO_VERSION=\"$(VERSION)\" -Isolver -I/usr/include/suitesparse $(shell pkg-config --cflags $(PKGS) 2>/dev/null)
+CPPFLAGS = -D_POSIX_C_SOURCE=200809L -DPORO_VERSION=\"$(VERSION)\" $(addprefix -I,$(SOLVER_DIRS)) -I/usr/include/suitesparse $(shell pkg-config --cflags $(PKGS) 2>/dev/null)
 VERSION := $(shell git describe --always --dirty --tags 2>/dev/null || echo unknown)
 CFLAGS  = -std=c11 $(OPT) -g -fopenmp $(WARN) $(SANFLAGS)
 LDLIBS  = $(shell pkg-config --libs $(PKGS) 2>/dev/null) -lcholmod -lm
 LDFLAGS = -fopenmp $(SANFLAGS)
 
-SOLVER_SRC = $(wildcard solver/*.c)
+# solver/ (README, "Layout"): the simulation object and its run loop at the top; case/ reads and
+# validates a case; material/ the constitutive models; mpm/ the grid, points, shape functions,
+# transfers and the phases every scheme shares; schemes/<name>/ each time-integration scheme;
+# output/ result files, checkpoints and reports. Every folder is on the include path.
+SOLVER_DIRS = $(patsubst %/,%,$(sort $(dir $(wildcard solver/*.h solver/*/*.h solver/*/*/*.h solver/*/*/*.c))))
+SOLVER_SRC = $(wildcard solver/*.c solver/*/*.c solver/*/*/*.c)
+SOLVER_HDR = $(wildcard solver/*.h solver/*/*.h solver/*/*/*.h)
 SOLVER_OBJ = $(SOLVER_SRC:%.c=$(BUILD)/%.o)
 LIBPORO    = $(BUILD)/libporo.a
 POROSOLVE  = $(BUILD)/poro-solve
@@ -82,7 +88,7 @@ bench: deps
 	@$(MAKE) --no-print-directory build-all
 	@bash bench/run.sh $(BUILD)
 
-$(BUILD)/%.o: %.c $(wildcard solver/*.h tests/*.h tests/verify/*.h common/*.h client/*.h server/*.h worker/*.h)
+$(BUILD)/%.o: %.c $(SOLVER_HDR) $(wildcard tests/*.h tests/verify/*.h common/*.h client/*.h server/*.h worker/*.h)
 	@mkdir -p $(dir $@)
 	$(CC) $(CPPFLAGS) -Icommon -Iclient $(CFLAGS) -c $< -o $@
 

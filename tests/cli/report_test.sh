@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# report_test.sh - drives `poro-solve report` (solver/report.h, docs/report.md) on real runs of
+# report_test.sh - drives `poro-solve report` (solver/output/report.h, docs/report.md) on real runs of
 # the Terzaghi column (tests/cases/terzaghi.json and its single-point twin, shortened to 0.01 s,
 # a frame every 0.005 s) and on bad input.
 #

@@ -1,5 +1,5 @@
 /*
- * case_load_test.c - tests of the case loader (solver/case_load.c, solver/case_json.c).
+ * case_load_test.c - tests of the case loader (solver/case/case_load.c, solver/case/case_json.c).
  *
  * The oracle for a valid case is the document itself: every value read back must equal the value
  * written, and every omitted value its documented default. Bad inputs are made by editing a valid
@@ -687,7 +687,7 @@ static void test_documented_example(const char *root)
 	free(text);
 }
 
-/* boundaries.<face>.soil "plate" (solver/plate.c): the plate's keys are read, and what cannot be a
+/* boundaries.<face>.soil "plate" (solver/schemes/semi_implicit/plate.c): the plate's keys are read, and what cannot be a
  * rigid impermeable plate is refused with the key named. */
 static void test_plate(void)
 {

@@ -1,5 +1,5 @@
 /*
- * checkpoint_test.c - tests of checkpoints and resume (solver/checkpoint.c, the resume path of
+ * checkpoint_test.c - tests of checkpoints and resume (solver/output/checkpoint.c, the resume path of
  * solver/run.c and output.c).
  *
  * Oracle: the uninterrupted run. A small loaded column under gravity (Hencky skeleton, so Be and
@@ -62,7 +62,7 @@ static const char case_format[] =
 	"   {\"name\": \"syy_mid\", \"kind\": \"average\", \"field\": \"stress_yy\","
 	"    \"box\": {\"min\": [0.0, 0.1], \"max\": [0.1, 0.15]}}]%s}";
 
-/* The same column under a rigid plate on the grid's top face (solver/plate.c) instead of the
+/* The same column under a rigid plate on the grid's top face (solver/schemes/semi_implicit/plate.c) instead of the
  * traction, drained at the bottom: the plate's velocity is rebuilt each step from the nodes'
  * momentum, so a resumed run needs nothing more in the checkpoint. %s: phases. */
 static const char plate_case_format[] =

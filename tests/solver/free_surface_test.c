@@ -1,5 +1,5 @@
 /*
- * free_surface_test.c - the interpolated and weak free-surface conditions (solver/free_surface.c).
+ * free_surface_test.c - the interpolated and weak free-surface conditions (solver/schemes/semi_implicit/free_surface.c).
  *
  * On the k = 1e-9 m/s Terzaghi column (consistent projection, drag in the correction, the
  * second-difference pressure stabilisation against the projection's node-to-node pattern; the

@@ -1,5 +1,5 @@
 /*
- * loads_test.c - tractions on body faces (solver/loads.c).
+ * loads_test.c - tractions on body faces (solver/mpm/loads.c).
  *
  * The oracle is the internal force itself: a body whose stress equals the traction (sigma N = t)
  * is in equilibrium, so the load's nodal forces and -sum_p V_p sigma grad S_I (transfer.c) should

@@ -1,5 +1,5 @@
 /*
- * oscillation_test.c - the oscillation index of solver/oscillation.c on fields whose answer is
+ * oscillation_test.c - the oscillation index of solver/output/oscillation.c on fields whose answer is
  * known: a point-level checkerboard, a checkerboard of whole cells (constant inside each cell, as
  * cell-wise averaging leaves p'), and a smooth field, on a 6 x 5 cell grid seeded 2x2 per cell
  * with high-entropy values.

@@ -1,5 +1,5 @@
 /*
- * output_test.c - tests of the results writer (solver/output.c, solver/output_xdmf.c).
+ * output_test.c - tests of the results writer (solver/output/output.c, solver/output/output_xdmf.c).
  *
  * Oracle: the values themselves. Particle sets are filled with high-entropy numbers, written as
  * frames, and read back with the HDF5 C API; every value must round-trip exactly (displacement as

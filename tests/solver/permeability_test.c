@@ -1,5 +1,5 @@
 /*
- * permeability_test.c - the conductivity laws of solver/permeability.c, and why the Xie-Leo cases
+ * permeability_test.c - the conductivity laws of solver/material/permeability.c, and why the Xie-Leo cases
  * use k = k0 (V/V0)^2.
  *
  * Oracles:

@@ -1,5 +1,5 @@
 /*
- * plate_test.c - rigid smooth plates on grid faces (solver/plate.c).
+ * plate_test.c - rigid smooth plates on grid faces (solver/schemes/semi_implicit/plate.c).
  *
  * Under a plate on a laterally confined column every horizontal section carries the same force,
  * so the column consolidates as under a uniform load: the oracle is Terzaghi's closed form

@@ -1,5 +1,5 @@
 /*
- * pressure_test.c - the consistent projection's matrix and right-hand side (solver/pressure.c)
+ * pressure_test.c - the consistent projection's matrix and right-hand side (solver/schemes/semi_implicit/pressure.c)
  * against a brute-force assembly.
  *
  * pressure.c assembles A = sum_I,c [G_s; G_w]_I^T K_I^-1 [G_s; G_w]_I row by row from banded

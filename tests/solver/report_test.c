@@ -1,5 +1,5 @@
 /*
- * report_test.c - tests of the run report (solver/report.h: report.c, report_frames.c,
+ * report_test.c - tests of the run report (solver/output/report.h: report.c, report_frames.c,
  * report_line.c, report_csv.c).
  *
  * Oracle: synthetic result files with known answers, written by the solver's own writer

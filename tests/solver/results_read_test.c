@@ -1,5 +1,5 @@
 /*
- * results_read_test.c - tests of the results reader (solver/results_read.c).
+ * results_read_test.c - tests of the results reader (solver/output/results_read.c).
  *
  * Oracle: the live simulation. A small consolidation column (double point, then single point)
  * runs through the library's sim_run() into a temporary directory; the reader must find the

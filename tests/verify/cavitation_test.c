@@ -1,5 +1,5 @@
 /*
- * cavitation_test.c - the pore water's tension limit (fluid.cavitation_pressure, solver/cavitation.c)
+ * cavitation_test.c - the pore water's tension limit (fluid.cavitation_pressure, solver/schemes/semi_implicit/cavitation.c)
  * on tests/cases/cavitation_column.json: a saturated column at k = 1e-9 m/s, undrained over the
  * run, pulled up by a traction T ramped over 1 s past what its water holds, p_cav = -100 kPa.
  * Closed form (one-dimensional, no body force, oedometric E since nu = 0): the total stress

@@ -17,7 +17,7 @@
  * failure check would turn into a coin toss).
  *
  * Each run goes through sim_run() into a temporary result.h5 and is measured by the run report
- * (solver/report.h), as a user measures it: the slide front (front_x: the farthest soil that
+ * (solver/output/report.h), as a user measures it: the slide front (front_x: the farthest soil that
  * started above the toe plain; the toe itself also counts foundation soil heaved in front of it),
  * the front of the debris' bulk (bulk_front_x: beyond it lies 1% of that soil's mass) and the
  * largest gap between the soil and water surfaces (double point), at the last frame.

@@ -16,7 +16,7 @@
  * Measured per run: crest settlement (probe 0 of the cases: the soil point nearest the crest
  * edge), the points mobilised (displacement above one cell) and the lowest initial height among
  * them (the depth of the failure), the oscillation index of the mean effective stress
- * (solver/oscillation.h) at the paper's 2, 4 and 6 s, the pore pressure along the lower shear
+ * (solver/output/oscillation.h) at the paper's 2, 4 and 6 s, the pore pressure along the lower shear
  * band at the paper's 3 s (Fig. 5b, sampled as `poro-solve report --line` does), the largest
  * relative displacement of a water point from the soil point it started on (§5.3: 0.0014 m at
  * k = 1e-7 and 0.0065 m at k = 1e-3 m/s), and the mass balance of both phases.

@@ -8,7 +8,7 @@
  *
  * make test (reduced size): the four variants at h = 0.2 m to t = SHORT_END (the load ramped over
  * 1 s has then reached 2 kPa). Measured: the oscillation index of the mean effective stress
- * (solver/oscillation.h: overshoot of each point over its lattice neighbours, RMS, over the RMS of
+ * (solver/output/oscillation.h: overshoot of each point over its lattice neighbours, RMS, over the RMS of
  * p'), and the same index over the cell means of p' (oscillation_index_blocks). Asserted: F-bar
  * lowers it against no stabilisation, and the modified F-bar (patch-wise) lowers it at least
  * OSCILLATION_RATIO-fold against no stabilisation and below F-bar's; between cells, the cell-wise

@@ -89,7 +89,7 @@ enum permeability_law {
 
 /* Velocity constraint of one phase on a grid face: free, slip (normal component zero: a roller),
  * fixed (both components zero), plate (a rigid smooth plate: the normal component is one velocity
- * shared by the whole face, driven by the plate's force; solver/plate.c). */
+ * shared by the whole face, driven by the plate's force; solver/schemes/semi_implicit/plate.c). */
 enum face_constraint { CONSTRAINT_FREE, CONSTRAINT_SLIP, CONSTRAINT_FIXED, CONSTRAINT_PLATE };
 /* Drainage of a grid face, independent of its velocity constraint: impermeable (no flux: the
  * natural condition of the pressure equation) or drained (pore pressure zero on the face). */

@@ -395,7 +395,7 @@ static void read_gravity(struct case_reader *r, const json_t *root, struct case_
 static void read_time_function(struct case_reader *r, const json_t *o, const char *base,
 			       struct case_time_function *tf);
 
-/* The rigid plate of a face whose soil is "plate" (solver/plate.c): its "plate" object, required
+/* The rigid plate of a face whose soil is "plate" (solver/schemes/semi_implicit/plate.c): its "plate" object, required
  * there and refused elsewhere. The plate is impermeable: the water's constraint is "plate" too,
  * moving with it. */
 static void read_plate(struct case_reader *r, const json_t *face, const char *p, struct case_boundary *b)
