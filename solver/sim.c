@@ -21,7 +21,7 @@
 #include <time.h>
 
 #include "shape.h"
-#include "sim_internal.h"
+#include "phases.h"
 #include "step_health.h"
 
 /* A seed point closer to a polygon edge than this many cell sizes lies on the edge: it is not
@@ -228,7 +228,7 @@ static enum poro_status build(struct sim *s)
 	if (c->formulation.velocity_update != VELOCITY_UPDATE_FLIP &&
 	    ((st = particles_add_affine(&s->soil, &s->err)) || (st = particles_add_affine(&s->water, &s->err))))
 		return st;
-	stabilisation_patches_init(s);
+	fbar_patches_init(s);
 	if ((st = pressure_system_init(&s->ps, &s->grid, s->soil.support, c->formulation.pressure_projection,
 				       c->formulation.free_surface != FREE_SURFACE_NODES, &s->err)))
 		return st;

@@ -14,6 +14,14 @@
 #include "spd_solve.h"
 #include "stable_dt.h"
 
+/* Returns from the calling function with a phase's status unless it is PORO_OK. */
+#define TRY(call)                                       \
+	do {                                            \
+		enum poro_status st_ = (call);          \
+		if (st_ != PORO_OK)                     \
+			return st_;                     \
+	} while (0)
+
 /* Standard gravity in the drag term n^2 rho_w g / k (000 Eq. 15): hydraulic conductivity is
  * defined with it, so it stays 9.81 m/s^2 even when a case switches the body force off. */
 #define CONDUCTIVITY_GRAVITY 9.81
@@ -94,8 +102,6 @@ double sim_clock(void);
 
 /* semi_implicit.c: one step of 000 §4.5. */
 enum poro_status semi_implicit_step(struct sim *s);
-/* semi_implicit.c: lays out the patches of the modified F-bar (000 Eq. 83) once, at create. */
-void stabilisation_patches_init(struct sim *s);
 
 /* pressure.c: the Poisson solve (000 §4.5 step 5). */
 /* surface_points: room for the interpolated free-surface condition's points (free_surface.c). */
@@ -165,6 +171,14 @@ struct load_band {
 void loads_init(struct sim *s);
 void loads_add_tractions(struct sim *s, double time, double *force);
 void loads_gravity(const struct case_spec *c, double time, double b[2]);
+/* 1 while the step being taken ends within the gravity ramp: the initialisation of 000 App. B.4
+ * and §5.4, during which gravity.elastic_loading, loading_conductivity and water_attached act. */
+int loads_in_gravity_ramp(const struct sim *s);
+/* 000 App. B.4 with gravity.elastic_loading: 1 for a step that ends within the gravity ramp (it is
+ * elastic); 2 for the first step after it, which first makes each point's present state, the one
+ * at the end of the ramp, its reference (material_reset_reference: p0, eps_v0^e, the image
+ * pressure from OCR); 0 otherwise and without elastic loading. */
+int loads_gravity_loading_stage(const struct sim *s);
 
 /* probes.c */
 void probes_init(struct sim *s);

@@ -15,6 +15,13 @@
 #include "case.h"
 #include "particles.h"
 
+/* The space dimension. The solver is 2-D, plane strain: nodal and per-point vectors are DIM
+ * interleaved components, per-point 2x2 tensors 4 (row-major), stresses 4 (xx, yy, xy, zz: the
+ * out-of-plane normal stress of plane strain), shape functions the tensor product of DIM 1-D
+ * factors. Code that assumes 2-D beyond these names says so; 3-D changes these layouts and the
+ * shape tables, not the phases. */
+#define DIM 2
+
 struct grid {
 	double origin[2];        /* m */
 	double h, inv_h;         /* cell size, m, and its inverse */

@@ -178,3 +178,24 @@ void loads_gravity(const struct case_spec *c, double time, double b[2])
 	b[0] = c->gravity.acceleration[0] * ramp;
 	b[1] = c->gravity.acceleration[1] * ramp;
 }
+
+/* Time t is at or before the end of the gravity ramp; steps are compared within a billionth of dt,
+ * so the step that lands on the ramp's end by rounding still counts as inside it. */
+static int by_ramp_end(const struct sim *s, double t)
+{
+	return t <= s->spec->gravity.ramp_time + 1e-9 * s->dt;
+}
+
+int loads_in_gravity_ramp(const struct sim *s)
+{
+	return s->spec->gravity.ramp_time > 0 && by_ramp_end(s, s->time + s->dt);
+}
+
+int loads_gravity_loading_stage(const struct sim *s)
+{
+	if (!s->spec->gravity.elastic_loading)
+		return 0;
+	if (loads_in_gravity_ramp(s))
+		return 1;
+	return by_ramp_end(s, s->time) ? 2 : 0;
+}
