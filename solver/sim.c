@@ -22,6 +22,7 @@
 
 #include "shape.h"
 #include "phases.h"
+#include "scheme.h"
 #include "step_health.h"
 
 /* A seed point closer to a polygon edge than this many cell sizes lies on the edge: it is not
@@ -186,19 +187,12 @@ static enum poro_status allocate_scratch(struct sim *s)
 	s->soil_coef = calloc(ns, sizeof(double));
 	s->water_scalar = calloc(nw, sizeof(double));
 	s->water_coef = calloc(nw, sizeof(double));
-	s->cell_fill = calloc((size_t)s->grid.cell_count, sizeof(double));
-	s->cell_fill_soil = calloc((size_t)s->grid.cell_count, sizeof(double));
 	s->patch_mass = calloc((size_t)s->grid.cell_count, sizeof(double));
 	s->patch_mass_Je = calloc((size_t)s->grid.cell_count, sizeof(double));
 	s->probe_point = calloc((size_t)s->spec->probe_count + 1, sizeof(int));
 	s->load_bands = calloc((size_t)s->spec->load_count + 1, sizeof *s->load_bands);
-	int plates = 0;
-	for (int f = 0; f < FACE_COUNT; f++)
-		plates += s->spec->boundaries[f].soil == CONSTRAINT_PLATE;
-	if (plates && !(s->plate_work = calloc((size_t)(FACE_COUNT + 2) * (size_t)s->grid.node_count, sizeof(double))))
-		return poro_error_set(&s->err, PORO_ENOMEM, "cannot allocate the plates' workspace");
 	if (!s->soil_grad || !s->soil_scalar || !s->soil_coef || !s->water_scalar ||
-	    !s->water_coef || !s->cell_fill || !s->cell_fill_soil || !s->patch_mass || !s->patch_mass_Je ||
+	    !s->water_coef || !s->patch_mass || !s->patch_mass_Je ||
 	    !s->probe_point || !s->load_bands)
 		return poro_error_set(&s->err, PORO_ENOMEM, "cannot allocate step workspaces");
 	return PORO_OK;
@@ -229,13 +223,11 @@ static enum poro_status build(struct sim *s)
 	    ((st = particles_add_affine(&s->soil, &s->err)) || (st = particles_add_affine(&s->water, &s->err))))
 		return st;
 	fbar_patches_init(s);
-	if ((st = pressure_system_init(&s->ps, &s->grid, s->soil.support, c->formulation.pressure_projection,
-				       c->formulation.free_surface != FREE_SURFACE_NODES, &s->err)))
-		return st;
 	boundary_mark(s);
 	loads_init(s);
 	probes_init(s);
-	return PORO_OK;
+	s->scheme = scheme_of(c->formulation.scheme);
+	return s->scheme->create(s);
 }
 
 enum poro_status sim_create(struct sim **out, const struct case_spec *c, struct poro_error *err)
@@ -268,21 +260,19 @@ void sim_destroy(struct sim **ps)
 		return;
 	particles_release(&s->water);
 	particles_release(&s->soil);
+	if (s->scheme)
+		s->scheme->destroy(s);
 	grid_fields_release(&s->f);
-	pressure_system_release(&s->ps);
 	free(s->materials);
 	free(s->soil_grad);
 	free(s->soil_scalar);
 	free(s->soil_coef);
 	free(s->water_scalar);
 	free(s->water_coef);
-	free(s->cell_fill);
-	free(s->cell_fill_soil);
 	free(s->patch_mass);
 	free(s->patch_mass_Je);
 	free(s->probe_point);
 	free(s->load_bands);
-	free(s->plate_work);
 	free(s);
 	*ps = NULL;
 }
@@ -306,7 +296,7 @@ static enum poro_status check_finite(struct sim *s)
 
 enum poro_status sim_step(struct sim *s)
 {
-	enum poro_status st = semi_implicit_step(s);
+	enum poro_status st = s->scheme->step(s);
 	if (!st)
 		st = check_finite(s);
 	if (st == PORO_ESOLVER)   /* the symptom is named; add what it likely follows from */

@@ -38,24 +38,24 @@ idx_t grid_cell_of(const struct grid *g, const double x[2])
 	return i + j * g->cells[0];
 }
 
-/* Every nodal array with its width: one table so init and release agree. */
-#define GRID_DOUBLE_FIELDS(X)                                                                  \
-	X(mass_s, 1) X(mass_w, 1) X(mass_w_points, 1) X(mass_w_v, 1) X(volume_s, 1) X(v_s, 2) X(v_w, 2)       \
-	X(v_s_old, 2) X(v_w_old, 2) X(v_s_star, 2) X(v_w_star, 2) X(porosity, 1)               \
-	X(conductivity, 1) X(drag_dt, 1) X(mobility_ratio, 1) X(pressure, 1) X(fit_moments, 9) X(dp, 1) X(force_w, 2) X(force, 2) X(rhs, 1)         \
-	X(correction_s, 2) X(correction_w, 2) X(du_s, 2)
+/* Every nodal array with its width and whether grid_fields_reset zeroes it (fit_moments is the
+ * scratch of a kernel that zeroes it itself): one table so init, reset and release agree. */
+#define GRID_DOUBLE_FIELDS(X)                                                                     \
+	X(mass_s, 1, 1) X(mass_w, 1, 1) X(mass_w_points, 1, 1) X(mass_w_v, 1, 1) X(volume_s, 1, 1)      \
+	X(v_s, DIM, 1) X(v_w, DIM, 1) X(v_s_old, DIM, 1) X(v_w_old, DIM, 1) X(porosity, 1, 1)           \
+	X(conductivity, 1, 1) X(pressure, 1, 1) X(fit_moments, 9, 0) X(force_w, DIM, 1)                  \
+	X(force, DIM, 1) X(du_s, DIM, 1)
 
 enum poro_status grid_fields_init(struct grid_fields *f, const struct grid *g, struct poro_error *err)
 {
 	memset(f, 0, sizeof *f);
 	size_t n = (size_t)g->node_count;
 	int ok = 1;
-#define ALLOC(name, width) if (ok) ok = (f->name = calloc(n * (width), sizeof(double))) != NULL;
+#define ALLOC(name, width, reset) if (ok) ok = (f->name = calloc(n * (width), sizeof(double))) != NULL;
 	GRID_DOUBLE_FIELDS(ALLOC)
 #undef ALLOC
 	if (ok)
-		ok = (f->cell_wet = calloc((size_t)g->cell_count, 1)) && (f->dirichlet = calloc(n, 1)) &&
-		     (f->surface = calloc(n, 1)) && (f->fix_s = calloc(n, 1)) && (f->fix_w = calloc(n, 1));
+		ok = (f->fix_s = calloc(n, 1)) && (f->fix_w = calloc(n, 1));
 	if (!ok) {
 		grid_fields_release(f);
 		return poro_error_set(err, PORO_ENOMEM, "cannot allocate a grid of %ld nodes", (long)n);
@@ -63,16 +63,21 @@ enum poro_status grid_fields_init(struct grid_fields *f, const struct grid *g, s
 	return PORO_OK;
 }
 
+void grid_fields_reset(struct grid_fields *f, const struct grid *g)
+{
+	const size_t n = (size_t)g->node_count;
+#define ZERO(name, width, reset) if (reset) memset(f->name, 0, n * (width) * sizeof(double));
+	GRID_DOUBLE_FIELDS(ZERO)
+#undef ZERO
+}
+
 void grid_fields_release(struct grid_fields *f)
 {
 	if (!f)
 		return;
-#define FREE(name, width) free(f->name);
+#define FREE(name, width, reset) free(f->name);
 	GRID_DOUBLE_FIELDS(FREE)
 #undef FREE
-	free(f->cell_wet);
-	free(f->dirichlet);
-	free(f->surface);
 	free(f->fix_s);
 	free(f->fix_w);
 	memset(f, 0, sizeof *f);

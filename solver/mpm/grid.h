@@ -6,8 +6,7 @@
  * no information between steps.
  *
  * Symbols follow 000 §4.2: M_s, M_w nodal masses (Eqs. 44, 50), n_I nodal porosity (Eq. 46),
- * k_I nodal conductivity (Eq. 47), v_s, v_w nodal velocities, v_s*, v_w* intermediate velocities
- * (Eqs. 52-53), dp the pore-pressure increment p^{t+1} - p^t (Eq. 60).
+ * k_I nodal conductivity (Eq. 47), v_s, v_w nodal velocities.
  */
 #ifndef PORO_GRID_H
 #define PORO_GRID_H
@@ -31,7 +30,8 @@ struct grid {
 	idx_t cell_count;
 };
 
-/* Nodal fields of one step; arrays of node_count (scalars) or 2 node_count (vectors, interleaved). */
+/* The nodal fields of one step that every scheme maps into; arrays of node_count (scalars) or
+ * DIM node_count (vectors, interleaved). A scheme's own nodal fields are in its state (scheme.h). */
 struct grid_fields {
 	double *mass_s;          /* M_sI, Eq. 44, kg/m */
 	double *mass_w;          /* M_wI, Eq. 50 */
@@ -40,31 +40,22 @@ struct grid_fields {
 	double *volume_s;        /* sum S V_sp: soil-point volume at the node */
 	double *v_s, *v_w;       /* v^t, then v^{t+1} after the correction (step 6) */
 	double *v_s_old, *v_w_old; /* v^t kept for the FLIP increment (step 7b) */
-	double *v_s_star, *v_w_star; /* intermediate velocities, Eqs. 52-53 */
 	double *porosity;        /* n_I, Eq. 46 (1 where there is no soil) */
 	double *conductivity;    /* k_I, Eq. 47, m/s */
-	double *drag_dt;         /* Q_I dt, Eq. 58 times the step, kg/m: the drag of both velocity updates */
-	double *mobility_ratio;  /* mixture mobility with drag over that without (pressure.c), 1 without drag */
 	double *pressure;        /* p^t_I: water-mass-weighted projection of point pressures (Eq. 77's
 				    inner sum, as a local linear fit: transfer.h), tension + */
 	double *fit_moments;     /* [9 node_count] scratch of that fit (p2g_scalar_linear_fit) */
-	double *dp;              /* p^{t+1} - p^t, Eq. 60 */
 	double *force_w;         /* F_w^ext - F_w^int, Eqs. 56-57, N/m */
 	double *force;           /* F^ext - F^int of the mixture, Eqs. 54-55 */
-	double *rhs;             /* Poisson right-hand side, Eq. 60 */
-	double *correction_s, *correction_w; /* G_s dp, G_w dp (Eqs. 67-68), N/m */
 	double *du_s;            /* MUSL displacement increment, step 8a, m */
-	signed char *cell_wet;   /* [cell_count] 1 if a pressure-carrying point lies in the cell */
-	signed char *dirichlet;  /* 1 if the pressure increment is prescribed at the node (free surface,
-				    drained face) */
-	signed char *surface;    /* enum surface_node (sim_internal.h): the node's part in the
-				    interpolated or weak free-surface condition */
 	unsigned char *fix_s;    /* velocity constraint bits per node: 1 = x fixed, 2 = y fixed (soil) */
 	unsigned char *fix_w;    /* same for water */
 };
 
 enum poro_status grid_init(struct grid *g, const struct case_grid *spec, struct poro_error *err);
 enum poro_status grid_fields_init(struct grid_fields *f, const struct grid *g, struct poro_error *err);
+/* Zeroes the fields a step maps into (000 §4.5 step 2: the grid carries nothing between steps). */
+void grid_fields_reset(struct grid_fields *f, const struct grid *g);
 void grid_fields_release(struct grid_fields *f);
 
 static inline idx_t grid_node(const struct grid *g, idx_t i, idx_t j)

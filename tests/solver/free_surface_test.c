@@ -37,7 +37,7 @@
 #include "case.h"
 #include "poro.h"
 #include "shape.h"
-#include "sim_internal.h"
+#include "semi_implicit.h"
 
 #define CASES "tests/cases/"
 #define STEPS 20
@@ -147,14 +147,15 @@ static struct column_run run_column(enum free_surface_condition condition, int p
 			free_surface_mark(s);
 			c->formulation.free_surface = FREE_SURFACE_NODES;
 		}
-		r.samples = s->ps.sample_count;
+		const struct semi_implicit *si = semi_implicit_of(s);
+		r.samples = si->ps.sample_count;
 		for (idx_t k = 0; k < r.samples; k++) {
-			const double *x = s->ps.samples + 2 * k;
+			const double *x = si->ps.samples + 2 * k;
 			r.placement_error = fmax(r.placement_error, fabs(x[1] - r.top));
 			if (x[0] <= 0.0 || x[0] >= c->bodies[0].max[0])
 				r.placement_error = INFINITY;
 		}
-		r.surface_pressure = largest_surface_pressure(s, s->ps.samples, r.samples) / r.q;
+		r.surface_pressure = largest_surface_pressure(s, si->ps.samples, r.samples) / r.q;
 	} else {
 		printf("INFO column run failed: %s\n", s ? sim_error(s)->message : err.message);
 	}
@@ -200,14 +201,15 @@ struct weak_run {
 /* Net nodal force of G p for a uniform nodal pressure p0 against the push -p0 L n_top. */
 static void check_push(struct sim *s, double width, struct weak_run *r)
 {
+	struct semi_implicit *si = semi_implicit_of(s);
 	const double p0 = 2.385e4;
 	const size_t nodes = (size_t)s->grid.node_count;
 	double *p = malloc(nodes * sizeof *p), *force = calloc(2 * nodes, sizeof *force);
 	for (size_t I = 0; I < nodes; I++)
 		p[I] = p0;
 	pressure_gradient_operators(s);
-	pressure_apply_gradient(s, s->ps.grad_s, p, force);
-	pressure_apply_gradient(s, s->ps.grad_w, p, force);
+	pressure_apply_gradient(s, si->ps.grad_s, p, force);
+	pressure_apply_gradient(s, si->ps.grad_w, p, force);
 	double fx = 0.0, fy = 0.0;
 	for (size_t I = 0; I < nodes; I++)
 		fx += force[2 * I], fy += force[2 * I + 1];
@@ -220,12 +222,13 @@ static void check_push(struct sim *s, double width, struct weak_run *r)
  * the top cell's points), the third held at zero. */
 static void check_unknowns(const struct sim *s, double top, struct weak_run *r)
 {
+	struct semi_implicit *si = semi_implicit_of(s);
 	const struct grid *g = &s->grid;
 	const idx_t first = (idx_t)ceil((top - g->origin[1]) / g->h + 1e-9);
 	r->ghosts_unknown = r->far_held = 1;
 	for (idx_t i = 0; i < g->nodes[0]; i++) {
-		r->ghosts_unknown &= !s->f.dirichlet[grid_node(g, i, first)];
-		r->far_held &= s->f.dirichlet[grid_node(g, i, first + 2)];
+		r->ghosts_unknown &= !si->dirichlet[grid_node(g, i, first)];
+		r->far_held &= si->dirichlet[grid_node(g, i, first + 2)];
 	}
 }
 

@@ -22,7 +22,7 @@
 #include "../verify/column.h"
 #include "case.h"
 #include "poro.h"
-#include "sim_internal.h"
+#include "semi_implicit.h"
 
 #define G_ACC 9.81
 #define RMS_TOLERANCE 0.02
@@ -51,14 +51,15 @@ static struct case_spec *plate_column(const char *phases, double *q)
 /* Largest |v_y - V| over the top face's nodes with soil (soil and water), m/s. */
 static double face_spread(const struct sim *s)
 {
+	struct semi_implicit *si = semi_implicit_of(s);
 	const struct grid *g = &s->grid;
 	double worst = 0.0;
 	for (idx_t i = 0; i < g->nodes[0]; i++) {
 		idx_t I = grid_node(g, i, g->cells[1]);
 		if (s->f.mass_s[I] > 0.0)
-			worst = fmax(worst, fabs(s->f.v_s[2 * I + 1] - s->plate_velocity[FACE_TOP]));
+			worst = fmax(worst, fabs(s->f.v_s[2 * I + 1] - si->plate_velocity[FACE_TOP]));
 		if (s->f.mass_w[I] > 0.0)
-			worst = fmax(worst, fabs(s->f.v_w[2 * I + 1] - s->plate_velocity[FACE_TOP]));
+			worst = fmax(worst, fabs(s->f.v_w[2 * I + 1] - si->plate_velocity[FACE_TOP]));
 	}
 	return worst;
 }
@@ -96,7 +97,7 @@ static void check_column(const char *phases)
 		while (ok && sim_steps_taken(s) < target) {
 			ok = !sim_step(s);
 			spread = fmax(spread, face_spread(s));
-			settlement -= c->time.dt * s->plate_velocity[FACE_TOP];
+			settlement -= c->time.dt * semi_implicit_of(s)->plate_velocity[FACE_TOP];
 		}
 		if (ok) {
 			rms[i] = terzaghi_rms_from_bottom(s, H, Tv[i], q);

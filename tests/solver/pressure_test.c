@@ -17,7 +17,7 @@
 #include "case.h"
 #include "phase_coupling.h"
 #include "poro.h"
-#include "sim_internal.h"
+#include "semi_implicit.h"
 
 #define CASES "tests/cases/"
 #define ASSEMBLY_TOLERANCE 1e-12   /* relative to the largest |A| or |b| */
@@ -45,8 +45,9 @@ static void dense_gradient(const struct sim *s, const struct particles *p, const
 /* Largest differences of A and b from the brute-force assembly, relative to their largest entries. */
 static void compare(const struct sim *s, double *a_err, double *b_err)
 {
+	struct semi_implicit *si = semi_implicit_of(s);
 	const struct grid_fields *f = &s->f;
-	const struct pressure_system *ps = &s->ps;
+	const struct pressure_system *ps = &si->ps;
 	const idx_t N = s->grid.node_count, nx = s->grid.nodes[0];
 	const int W = ps->width, R = ps->radius;
 	double *Gs = calloc((size_t)N * N * 2, sizeof(double)), *Gw = calloc((size_t)N * N * 2, sizeof(double));
@@ -72,10 +73,10 @@ static void compare(const struct sim *s, double *a_err, double *b_err)
 	for (idx_t I = 0; I < N; I++)
 		for (int c = 0; c < 2; c++) {
 			const struct phase_coupling K = phase_coupling_inverse(f->mass_s[I], f->mass_w[I],
-									       drag ? f->drag_dt[I] : 0.0,
+									       drag ? si->drag_dt[I] : 0.0,
 									       f->fix_s[I] & (1 << c), f->fix_w[I] & (1 << c));
-			const double vs = K.ss > 0.0 ? f->v_s_star[2 * I + c] : 0.0;
-			const double vw = K.ww > 0.0 ? f->v_w_star[2 * I + c] : 0.0;
+			const double vs = K.ss > 0.0 ? si->v_s_star[2 * I + c] : 0.0;
+			const double vw = K.ww > 0.0 ? si->v_w_star[2 * I + c] : 0.0;
 			for (idx_t P = 0; P < N; P++) {
 				const double gsP = Gs[((size_t)I * N + P) * 2 + c], gwP = Gw[((size_t)I * N + P) * 2 + c];
 				if (gsP == 0.0 && gwP == 0.0)
@@ -91,7 +92,7 @@ static void compare(const struct sim *s, double *a_err, double *b_err)
 	for (idx_t P = 0; P < N; P++) {
 		const idx_t pi = P % nx, pj = P / nx;
 		b_max = fmax(b_max, fabs(b[P]));
-		b_diff = fmax(b_diff, fabs(b[P] - f->rhs[P]));
+		b_diff = fmax(b_diff, fabs(b[P] - si->rhs[P]));
 		for (idx_t Q = 0; Q < N; Q++) {
 			const idx_t dx = Q % nx - pi, dy = Q / nx - pj;
 			const double ref = A[(size_t)P * N + Q];

@@ -28,15 +28,16 @@
  * reaches every node whose support holds a cavitating point, in proportion, and the same column
  * carries its load (tests/verify/cavitation_test.c, docs/numerics.md "Cavitation").
  */
-#include "sim_internal.h"
+#include "semi_implicit.h"
 
 void cavitation_add_storage(struct sim *s)
 {
+	struct semi_implicit *si = semi_implicit_of(s);
 	const struct case_spec *c = s->spec;
 	if (c->fluid.cavitation_pressure == 0.0)   /* no limit (the loader allows only < 0 otherwise) */
 		return;
 	const struct particles *w = &s->water;   /* the pressure carriers, single point too */
-	struct pressure_system *ps = &s->ps;
+	struct pressure_system *ps = &si->ps;
 	const int W = ps->width, centre = ps->radius + ps->radius * W, S = w->support;
 	const idx_t nx = s->grid.nodes[0];
 	const double boiling = -c->fluid.cavitation_pressure;   /* internal sign: tension positive */

@@ -65,7 +65,7 @@
 #include <string.h>
 
 #include "shape.h"
-#include "sim_internal.h"
+#include "semi_implicit.h"
 
 /* A cell is full (below the free surface) when its points' volumes reach this fraction of it. */
 #define FREE_SURFACE_FILL 0.5
@@ -107,28 +107,28 @@ static int on_drained_face(const struct sim *s, idx_t i, idx_t j)
 	       (j == g->cells[1] && bc[FACE_TOP].drainage == DRAINAGE_DRAINED);
 }
 
-/* f->cell_wet; s->cell_fill (water) and, double point, s->cell_fill_soil hold the volumes. */
+/* si->cell_wet; si->cell_fill (water) and, double point, si->cell_fill_soil hold the volumes. */
 static void mark_full_cells(struct sim *s)
 {
+	struct semi_implicit *si = semi_implicit_of(s);
 	const struct grid *g = &s->grid;
-	struct grid_fields *f = &s->f;
 	const struct case_formulation *form = &s->spec->formulation;
 	const int nodes_laplacian = form->free_surface == FREE_SURFACE_NODES &&
 				    form->pressure_projection == PROJECTION_LAPLACIAN;
 	const double full = (nodes_laplacian ? FREE_SURFACE_FILL_NODES_LAPLACIAN : FREE_SURFACE_FILL) * g->h * g->h;
-	cell_volumes(g, &s->water, s->cell_fill);
+	cell_volumes(g, &s->water, si->cell_fill);
 	for (idx_t c = 0; c < g->cell_count; c++)
-		f->cell_wet[c] = s->cell_fill[c] >= full;
+		si->cell_wet[c] = si->cell_fill[c] >= full;
 	if (!s->double_point)
 		return;
 	/* saturated soil fills a cell below the top of its column's water (file comment) */
-	cell_volumes(g, &s->soil, s->cell_fill_soil);
+	cell_volumes(g, &s->soil, si->cell_fill_soil);
 	for (idx_t ci = 0; ci < g->cells[0]; ci++) {
 		int below_water = 0;
 		for (idx_t cj = g->cells[1] - 1; cj >= 0; cj--) {
 			idx_t c = ci + cj * g->cells[0];
-			below_water |= f->cell_wet[c];
-			f->cell_wet[c] |= below_water && s->cell_fill_soil[c] >= full;
+			below_water |= si->cell_wet[c];
+			si->cell_wet[c] |= below_water && si->cell_fill_soil[c] >= full;
 		}
 	}
 }
@@ -136,8 +136,9 @@ static void mark_full_cells(struct sim *s)
 /* Cell (ci, cj) lies inside the grid and is full. */
 static int cell_full(const struct sim *s, idx_t ci, idx_t cj)
 {
+	struct semi_implicit *si = semi_implicit_of(s);
 	const struct grid *g = &s->grid;
-	return ci >= 0 && cj >= 0 && ci < g->cells[0] && cj < g->cells[1] && s->f.cell_wet[ci + cj * g->cells[0]];
+	return ci >= 0 && cj >= 0 && ci < g->cells[0] && cj < g->cells[1] && si->cell_wet[ci + cj * g->cells[0]];
 }
 
 /* Cell (ci, cj), inside the grid or beyond a face, counts as dry: not full, or open air. */
@@ -154,13 +155,14 @@ static int cell_dry(const struct sim *s, const int open[FACE_COUNT], idx_t ci, i
  * in double point by water or soil, whichever fills more. */
 static double cell_fraction(const struct sim *s, idx_t ci, idx_t cj)
 {
+	struct semi_implicit *si = semi_implicit_of(s);
 	const struct grid *g = &s->grid;
 	if (ci < 0 || cj < 0 || ci >= g->cells[0] || cj >= g->cells[1])
 		return 0.0;
 	const idx_t c = ci + cj * g->cells[0];
-	double v = s->cell_fill[c];
-	if (s->double_point && s->f.cell_wet[c] && s->cell_fill_soil[c] > v)
-		v = s->cell_fill_soil[c];
+	double v = si->cell_fill[c];
+	if (s->double_point && si->cell_wet[c] && si->cell_fill_soil[c] > v)
+		v = si->cell_fill_soil[c];
 	return fmin(v / (g->h * g->h), 1.0);
 }
 
@@ -168,8 +170,9 @@ static double cell_fraction(const struct sim *s, idx_t ci, idx_t cj)
  * neighbour in direction (dx, dy), and the face's two nodes taken from the prescribed set. */
 static void add_surface_face(struct sim *s, idx_t ci, idx_t cj, int dx, int dy)
 {
+	struct semi_implicit *si = semi_implicit_of(s);
 	const struct grid *g = &s->grid;
-	struct pressure_system *ps = &s->ps;
+	struct pressure_system *ps = &si->ps;
 	double d = cell_fraction(s, ci, cj) + cell_fraction(s, ci + dx, cj + dy) - 1.0;
 	d = fmax(-0.5, fmin(0.5, d));
 	const double cx = g->origin[0] + ((double)ci + 0.5 + 0.5 * dx + d * dx) * g->h;
@@ -189,9 +192,9 @@ static void add_surface_face(struct sim *s, idx_t ci, idx_t cj, int dx, int dy)
 	for (int e = 0; e < 2; e++) {
 		const idx_t i = ci + (dx ? dx > 0 : e), j = cj + (dy ? dy > 0 : e);
 		const idx_t I = grid_node(g, i, j);
-		if (s->f.dirichlet[I] && !on_drained_face(s, i, j)) {
-			s->f.dirichlet[I] = 0;
-			s->f.surface[I] = SURFACE_ON;
+		if (si->dirichlet[I] && !on_drained_face(s, i, j)) {
+			si->dirichlet[I] = 0;
+			si->surface[I] = SURFACE_ON;
 		}
 	}
 }
@@ -200,11 +203,12 @@ static void add_surface_face(struct sim *s, idx_t ci, idx_t cj, int dx, int dy)
  * drained grid faces. */
 static void place_surface(struct sim *s, const int open[FACE_COUNT])
 {
+	struct semi_implicit *si = semi_implicit_of(s);
 	const struct grid *g = &s->grid;
 	static const int dir[FACE_COUNT][2] = {{-1, 0}, {1, 0}, {0, -1}, {0, 1}};   /* enum grid_face order */
 	for (idx_t cj = 0; cj < g->cells[1]; cj++)
 		for (idx_t ci = 0; ci < g->cells[0]; ci++) {
-			if (!s->f.cell_wet[ci + cj * g->cells[0]])
+			if (!si->cell_wet[ci + cj * g->cells[0]])
 				continue;
 			for (int k = 0; k < FACE_COUNT; k++) {
 				const idx_t ai = ci + dir[k][0], aj = cj + dir[k][1];
@@ -247,8 +251,8 @@ static int weak_node(const struct sim *s, const int open[FACE_COUNT], idx_t i, i
 
 void free_surface_mark(struct sim *s)
 {
+	struct semi_implicit *si = semi_implicit_of(s);
 	const struct grid *g = &s->grid;
-	struct grid_fields *f = &s->f;
 	const struct case_boundary *bc = s->spec->boundaries;
 	/* beyond a face where water moves freely is open air (dry); beyond a wall, nothing */
 	const int open[FACE_COUNT] = {bc[FACE_LEFT].water == CONSTRAINT_FREE, bc[FACE_RIGHT].water == CONSTRAINT_FREE,
@@ -261,14 +265,14 @@ void free_surface_mark(struct sim *s)
 			const idx_t I = grid_node(g, i, j);
 			if (weak) {
 				const int k = weak_node(s, open, i, j, S);
-				f->dirichlet[I] = (signed char)(k < 0);
-				f->surface[I] = (signed char)(k < 0 ? SURFACE_NONE : k);
+				si->dirichlet[I] = (signed char)(k < 0);
+				si->surface[I] = (signed char)(k < 0 ? SURFACE_NONE : k);
 			} else {
-				f->dirichlet[I] = (signed char)node_dry(s, open, i, j);
-				f->surface[I] = SURFACE_NONE;
+				si->dirichlet[I] = (signed char)node_dry(s, open, i, j);
+				si->surface[I] = SURFACE_NONE;
 			}
 		}
-	s->ps.sample_count = 0;
+	si->ps.sample_count = 0;
 	if (s->spec->formulation.free_surface != FREE_SURFACE_NODES)
 		place_surface(s, open);
 }
@@ -277,8 +281,9 @@ void free_surface_mark(struct sim *s)
  * points, into a gradient operator laid out as pressure.c's (row I, offsets of J within radius). */
 void free_surface_add_boundary_term(const struct sim *s, const double *mass, double *G)
 {
+	struct semi_implicit *si = semi_implicit_of(s);
 	const struct grid *g = &s->grid;
-	const struct pressure_system *ps = &s->ps;
+	const struct pressure_system *ps = &si->ps;
 	const enum case_shape kind = s->spec->formulation.shape;
 	const int S = shape_support(kind), W = ps->g_width, R = ps->g_radius;
 	double floor_mass = 0.0;
@@ -307,11 +312,12 @@ void free_surface_add_boundary_term(const struct sim *s, const double *mass, dou
 
 void free_surface_add_penalty(struct sim *s, double scale)
 {
+	struct semi_implicit *si = semi_implicit_of(s);
 	if (s->spec->formulation.free_surface != FREE_SURFACE_INTERPOLATED)
 		return;
 	const struct grid *g = &s->grid;
 	struct grid_fields *f = &s->f;
-	struct pressure_system *ps = &s->ps;
+	struct pressure_system *ps = &si->ps;
 	const enum case_shape kind = s->spec->formulation.shape;
 	const int S = shape_support(kind), W = ps->width, R = ps->radius;
 	const double beta = s->spec->formulation.free_surface_penalty_factor * scale;
@@ -333,7 +339,7 @@ void free_surface_add_penalty(struct sim *s, double scale)
 			if (w[a] == 0.0)
 				continue;
 			const idx_t I = node0 + a % S + (a / S) * g->nodes[0];
-			f->rhs[I] -= beta * w[a] * p_old;
+			si->rhs[I] -= beta * w[a] * p_old;
 			double *row = ps->stencil + (size_t)I * W * W;
 			for (int b = 0; b < S * S; b++)
 				row[(b % S - a % S + R) + (b / S - a / S + R) * W] += beta * w[a] * w[b];

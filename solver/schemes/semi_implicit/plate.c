@@ -31,7 +31,7 @@
 #include <math.h>
 #include <string.h>
 
-#include "sim_internal.h"
+#include "semi_implicit.h"
 #include "transfer.h"
 
 /* The normal axis of a face (0: x for left and right) and its inward sign. */
@@ -82,6 +82,7 @@ static void set_face_velocity(struct sim *s, int face, double V, double *v_s, do
 
 void plate_predict(struct sim *s)
 {
+	struct semi_implicit *si = semi_implicit_of(s);
 	const struct grid_fields *f = &s->f;
 	for (int face = 0; face < FACE_COUNT; face++) {
 		const struct case_boundary *b = &s->spec->boundaries[face];
@@ -97,8 +98,8 @@ void plate_predict(struct sim *s)
 		}
 		force += inward_sign(face) * b->plate.force *
 			 case_time_function_value(&b->plate.time_function, s->time + s->dt);
-		s->plate_velocity[face] = mass > 0.0 ? (momentum + s->dt * force) / mass : 0.0;
-		set_face_velocity(s, face, s->plate_velocity[face], f->v_s_star, f->v_w_star);
+		si->plate_velocity[face] = mass > 0.0 ? (momentum + s->dt * force) / mass : 0.0;
+		set_face_velocity(s, face, si->plate_velocity[face], si->v_s_star, si->v_w_star);
 	}
 }
 
@@ -122,8 +123,9 @@ static double plate_mass(const struct sim *s, int face)
  * increment. */
 static double plate_impulse(struct sim *s, int face, const double *x)
 {
+	struct semi_implicit *si = semi_implicit_of(s);
 	const struct grid *g = &s->grid;
-	double *force = s->f.correction_w;   /* scratch: free here, left zero */
+	double *force = si->correction_w;   /* scratch: free here, left zero */
 	const int c = face_axis(face);
 	memset(force, 0, 2 * sizeof(double) * (size_t)g->node_count);
 	g2p_scalar(g, &s->water, x, s->water_scalar);
@@ -140,10 +142,11 @@ static double plate_impulse(struct sim *s, int face, const double *x)
  * z (nodal, zero on prescribed nodes). Solved on the reduced system pressure_solve factorised. */
 static enum poro_status plate_response(struct sim *s, int face, idx_t n, double *z)
 {
-	struct pressure_system *ps = &s->ps;
+	struct semi_implicit *si = semi_implicit_of(s);
+	struct pressure_system *ps = &si->ps;
 	const struct grid *g = &s->grid;
 	double *unit = s->f.du_s;   /* zero until step 8; left zero */
-	double *b = s->plate_work + (size_t)FACE_COUNT * (size_t)g->node_count, *x = b + g->node_count;
+	double *b = si->plate_work + (size_t)FACE_COUNT * (size_t)g->node_count, *x = b + g->node_count;
 	const int c = face_axis(face);
 	for (idx_t k = 0; k < face_node_count(g, face); k++)
 		unit[2 * face_node(g, face, k) + c] = 1.0;
@@ -168,6 +171,7 @@ static enum poro_status plate_response(struct sim *s, int face, idx_t n, double 
  * a mass on an incompressible mixture, and its velocity grew by a factor of about -24 a step. */
 enum poro_status plate_couple_pressure(struct sim *s, idx_t n)
 {
+	struct semi_implicit *si = semi_implicit_of(s);
 	const size_t nodes = (size_t)s->grid.node_count;
 	int face_of[FACE_COUNT], plates = 0;
 	double A[FACE_COUNT][FACE_COUNT + 1];
@@ -175,15 +179,15 @@ enum poro_status plate_couple_pressure(struct sim *s, idx_t n)
 		if (s->spec->boundaries[face].soil == CONSTRAINT_PLATE)
 			face_of[plates++] = face;
 	for (int k = 0; k < plates; k++) {
-		enum poro_status st = plate_response(s, face_of[k], n, s->plate_work + (size_t)k * nodes);
+		enum poro_status st = plate_response(s, face_of[k], n, si->plate_work + (size_t)k * nodes);
 		if (st)
 			return st;
 	}
 	for (int j = 0; j < plates; j++) {
 		const double M = plate_mass(s, face_of[j]);
 		for (int k = 0; k < plates; k++)
-			A[j][k] = (j == k) - (M > 0.0 ? plate_impulse(s, face_of[j], s->plate_work + (size_t)k * nodes) / M : 0.0);
-		A[j][plates] = M > 0.0 ? plate_impulse(s, face_of[j], s->f.dp) / M : 0.0;
+			A[j][k] = (j == k) - (M > 0.0 ? plate_impulse(s, face_of[j], si->plate_work + (size_t)k * nodes) / M : 0.0);
+		A[j][plates] = M > 0.0 ? plate_impulse(s, face_of[j], si->dp) / M : 0.0;
 	}
 	/* Gaussian elimination with partial pivoting on the plates x plates system */
 	for (int col = 0; col < plates; col++) {
@@ -213,25 +217,27 @@ enum poro_status plate_couple_pressure(struct sim *s, idx_t n)
 	}
 	for (int k = 0; k < plates; k++)
 		for (size_t I = 0; I < nodes; I++)
-			s->f.dp[I] += dV[k] * s->plate_work[(size_t)k * nodes + I];
+			si->dp[I] += dV[k] * si->plate_work[(size_t)k * nodes + I];
 	return PORO_OK;
 }
 
 void plate_correct(struct sim *s)
 {
+	struct semi_implicit *si = semi_implicit_of(s);
 	for (int face = 0; face < FACE_COUNT; face++) {
 		if (s->spec->boundaries[face].soil != CONSTRAINT_PLATE)
 			continue;
 		const double mass = plate_mass(s, face);
 		if (mass > 0.0)
-			s->plate_velocity[face] += plate_impulse(s, face, s->f.dp) / mass;
-		set_face_velocity(s, face, s->plate_velocity[face], s->f.v_s, s->f.v_w);
+			si->plate_velocity[face] += plate_impulse(s, face, si->dp) / mass;
+		set_face_velocity(s, face, si->plate_velocity[face], s->f.v_s, s->f.v_w);
 	}
 }
 
 void plate_displace(struct sim *s, double *du_s)
 {
+	struct semi_implicit *si = semi_implicit_of(s);
 	for (int face = 0; face < FACE_COUNT; face++)
 		if (s->spec->boundaries[face].soil == CONSTRAINT_PLATE)
-			set_face_velocity(s, face, s->dt * s->plate_velocity[face], du_s, NULL);
+			set_face_velocity(s, face, s->dt * si->plate_velocity[face], du_s, NULL);
 }

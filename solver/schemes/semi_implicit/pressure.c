@@ -29,7 +29,7 @@
 #include <string.h>
 
 #include "phase_coupling.h"
-#include "sim_internal.h"
+#include "semi_implicit.h"
 #include "transfer.h"
 
 enum poro_status pressure_system_init(struct pressure_system *ps, const struct grid *g, int support,
@@ -131,12 +131,13 @@ static inline void add_point_laplacian(struct pressure_system *ps, idx_t nx, con
 /* Adds sum_p coef_p grad S_Ip . grad S_Jp into the stencil (Eq. 61). */
 static void assemble_laplacian(struct sim *s, const struct particles *p, const double *coef)
 {
+	struct semi_implicit *si = semi_implicit_of(s);
 	const idx_t nx = s->grid.nodes[0];
 	for (idx_t q = 0; q < p->n; q++) {
 		if (p->support == 3)
-			add_point_laplacian(&s->ps, nx, p, q, coef[q], 3);
+			add_point_laplacian(&si->ps, nx, p, q, coef[q], 3);
 		else
-			add_point_laplacian(&s->ps, nx, p, q, coef[q], p->support);
+			add_point_laplacian(&si->ps, nx, p, q, coef[q], p->support);
 	}
 }
 
@@ -170,18 +171,20 @@ static inline void add_point_gradient(const struct pressure_system *ps, idx_t nx
 /* G_IJ = f_I sum_p V_p S_Ip grad S_Jp for one set (Eqs. 67-68 before the nodal porosity factor). */
 static void add_gradient_operator(const struct sim *s, const struct particles *p, double *G)
 {
+	struct semi_implicit *si = semi_implicit_of(s);
 	const idx_t nx = s->grid.nodes[0];
 	for (idx_t q = 0; q < p->n; q++) {
 		if (p->support == 3)
-			add_point_gradient(&s->ps, nx, p, q, G, 3);
+			add_point_gradient(&si->ps, nx, p, q, G, 3);
 		else
-			add_point_gradient(&s->ps, nx, p, q, G, p->support);
+			add_point_gradient(&si->ps, nx, p, q, G, p->support);
 	}
 }
 
 void pressure_gradient_operators(struct sim *s)
 {
-	struct pressure_system *ps = &s->ps;
+	struct semi_implicit *si = semi_implicit_of(s);
+	struct pressure_system *ps = &si->ps;
 	const size_t gst = (size_t)ps->g_width * ps->g_width * 2, nodes = (size_t)s->grid.node_count;
 	memset(ps->grad_s, 0, sizeof(double) * nodes * gst);
 	memset(ps->grad_w, 0, sizeof(double) * nodes * gst);
@@ -209,8 +212,9 @@ void pressure_gradient_operators(struct sim *s)
 
 void pressure_apply_gradient(const struct sim *s, const double *G, const double *pressure, double *out)
 {
+	struct semi_implicit *si = semi_implicit_of(s);
 	const struct grid *g = &s->grid;
-	const int W = s->ps.g_width, R = s->ps.g_radius;
+	const int W = si->ps.g_width, R = si->ps.g_radius;
 	for (idx_t I = 0; I < g->node_count; I++) {
 		const idx_t i = I % g->nodes[0], j = I / g->nodes[0];
 		const double *row = G + (size_t)I * W * W * 2;
@@ -232,14 +236,16 @@ void pressure_apply_gradient(const struct sim *s, const double *G, const double 
 /* The drag the correction applies at node I (zero when formulation.drag_in_correction is off). */
 static double correction_drag(const struct sim *s, idx_t I)
 {
-	return s->spec->formulation.drag_in_correction ? s->f.drag_dt[I] : 0.0;
+	struct semi_implicit *si = semi_implicit_of(s);
+	return s->spec->formulation.drag_in_correction ? si->drag_dt[I] : 0.0;
 }
 
 /* K^-1 (ss, sw, ww) of the correction at every node and component, into ps->coupling. */
 static void store_correction_coupling(struct sim *s)
 {
+	struct semi_implicit *si = semi_implicit_of(s);
 	const struct grid_fields *f = &s->f;
-	double *k = s->ps.coupling;
+	double *k = si->ps.coupling;
 	for (idx_t I = 0; I < s->grid.node_count; I++)
 		for (int c = 0; c < 2; c++) {
 			const struct phase_coupling K = phase_coupling_inverse(f->mass_s[I], f->mass_w[I],
@@ -262,9 +268,9 @@ static void store_correction_coupling(struct sim *s)
  * every entry sums the same terms in the same order. */
 static void assemble_exact_projection(struct sim *s)
 {
+	struct semi_implicit *si = semi_implicit_of(s);
 	const struct grid *g = &s->grid;
-	struct grid_fields *f = &s->f;
-	struct pressure_system *ps = &s->ps;
+	struct pressure_system *ps = &si->ps;
 	const int Wg = ps->g_width, Rg = ps->g_radius, W = ps->width, R = ps->radius;
 	const idx_t nx = g->nodes[0], ny = g->nodes[1];
 	/* node offsets (x, y) of the G stencil entries, tabulated once */
@@ -293,8 +299,8 @@ static void assemble_exact_projection(struct sim *s)
 				const double gsa = gs[2 * a + c], gwa = gw[2 * a + c];
 				if ((K[0] == 0.0 && K[2] == 0.0) || (gsa == 0.0 && gwa == 0.0))
 					continue;
-				const double vs = K[0] > 0.0 ? f->v_s_star[2 * I + c] : 0.0;
-				const double vw = K[2] > 0.0 ? f->v_w_star[2 * I + c] : 0.0;
+				const double vs = K[0] > 0.0 ? si->v_s_star[2 * I + c] : 0.0;
+				const double vw = K[2] > 0.0 ? si->v_w_star[2 * I + c] : 0.0;
 				b -= (gsa * vs + gwa * vw) / s->dt;
 				/* row a of K^-1 [G_s; G_w], to be contracted with the column of each bb */
 				ts[c] = K[0] * gsa + K[1] * gwa, tw[c] = K[1] * gsa + K[2] * gwa;
@@ -314,7 +320,7 @@ static void assemble_exact_projection(struct sim *s)
 				     (ts[1] * gs[2 * bb + 1] + tw[1] * gw[2 * bb + 1]);
 			}
 		}
-		f->rhs[P] += b;
+		si->rhs[P] += b;
 	}
 }
 
@@ -324,19 +330,20 @@ static void assemble_exact_projection(struct sim *s)
  * point's coefficient is scaled by the ratio of the two, interpolated from the nodes. */
 static void scale_by_mobility_ratio(struct sim *s, const struct particles *p, double *coef, double *scratch)
 {
+	struct semi_implicit *si = semi_implicit_of(s);
 	struct grid_fields *f = &s->f;
 	if (!s->spec->formulation.drag_in_correction)
 		return;
 	for (idx_t I = 0; I < s->grid.node_count; I++) {
 		const double n = f->porosity[I], Ms = f->mass_s[I], Mw = f->mass_w[I];
-		f->mobility_ratio[I] = 1.0;
+		si->mobility_ratio[I] = 1.0;
 		if (!(Ms > 0.0 && Mw > 0.0))
 			continue;
-		const struct phase_coupling K = phase_coupling_inverse(Ms, Mw, f->drag_dt[I], 0, 0);
+		const struct phase_coupling K = phase_coupling_inverse(Ms, Mw, si->drag_dt[I], 0, 0);
 		const double with_drag = (1 - n) * (1 - n) * K.ss + 2 * n * (1 - n) * K.sw + n * n * K.ww;
-		f->mobility_ratio[I] = with_drag / ((1 - n) * (1 - n) / Ms + n * n / Mw);
+		si->mobility_ratio[I] = with_drag / ((1 - n) * (1 - n) / Ms + n * n / Mw);
 	}
-	g2p_scalar(&s->grid, p, f->mobility_ratio, scratch);
+	g2p_scalar(&s->grid, p, si->mobility_ratio, scratch);
 	for (idx_t q = 0; q < p->n; q++)
 		coef[q] *= scratch[q];
 }
@@ -344,9 +351,10 @@ static void scale_by_mobility_ratio(struct sim *s, const struct particles *p, do
 /* Right-hand side (D_s v_s + D_w v_w) / dt, Eqs. 62-63 evaluated through the point divergences. */
 void pressure_divergence_rhs(struct sim *s, const double *v_s, const double *v_w, double *out)
 {
+	struct semi_implicit *si = semi_implicit_of(s);
 	struct grid_fields *f = &s->f;
 	const struct grid *g = &s->grid;
-	double *sum_s = f->correction_s, *sum_w = f->correction_w;   /* free until step 6 */
+	double *sum_s = si->correction_s, *sum_w = si->correction_w;   /* free until step 6 */
 	memset(sum_s, 0, sizeof(double) * (size_t)g->node_count);
 	memset(sum_w, 0, sizeof(double) * (size_t)g->node_count);
 	p2g_point_divergence(g, &s->soil, s->soil.volume, v_s, sum_s);
@@ -362,9 +370,10 @@ void pressure_divergence_rhs(struct sim *s, const double *v_s, const double *v_w
  * values to b. The system solved is L dp = (D_s v_s* + D_w v_w*) / dt, Eq. 60 divided by dt. */
 static idx_t build_reduced_system(struct sim *s, double diagonal_mean)
 {
+	struct semi_implicit *si = semi_implicit_of(s);
 	const struct grid *g = &s->grid;
 	struct grid_fields *f = &s->f;
-	struct pressure_system *ps = &s->ps;
+	struct pressure_system *ps = &si->ps;
 	const int W = ps->width, R = ps->radius, centre = R + R * W;
 	/* the consistent projection solves for the multiplier p^t + dp itself, so its boundary
 	 * value must be reached through dp */
@@ -372,13 +381,13 @@ static idx_t build_reduced_system(struct sim *s, double diagonal_mean)
 	idx_t n = 0;
 	for (idx_t I = 0; I < g->node_count; I++) {
 		int active = ps->stencil[(size_t)I * W * W + centre] > 0.0;
-		ps->unknown[I] = active && !f->dirichlet[I] ? n++ : -1;
+		ps->unknown[I] = active && !si->dirichlet[I] ? n++ : -1;
 		/* with the smoothing of step 7c the prescribed p^{t+1} = 0 is set on the nodal pressure
 		 * itself (semi_implicit.c), and the increment the correction sees there is zero: the
 		 * nodal p^t of a boundary node is a projection of the nearby points' pressures, not a
 		 * pressure the boundary had, and subtracting it every step drives water through drained
 		 * faces several times faster than Darcy's law */
-		f->dp[I] = active && f->dirichlet[I] && !remap ? -f->pressure[I] : 0.0;
+		si->dp[I] = active && si->dirichlet[I] && !remap ? -f->pressure[I] : 0.0;
 	}
 	free_surface_add_penalty(s, diagonal_mean);
 	idx_t nnz = 0;
@@ -387,7 +396,7 @@ static idx_t build_reduced_system(struct sim *s, double diagonal_mean)
 		if (col < 0)
 			continue;
 		ps->colptr[col] = nnz;
-		double b = f->rhs[J];
+		double b = si->rhs[J];
 		const idx_t i = J % g->nodes[0], j = J / g->nodes[0];
 		const double *row = ps->stencil + (size_t)J * W * W;
 		for (int dy = -R; dy <= R; dy++)
@@ -399,8 +408,8 @@ static idx_t build_reduced_system(struct sim *s, double diagonal_mean)
 				if (ps->unknown[I] >= 0 && ps->unknown[I] <= col) {
 					ps->rowidx[nnz] = ps->unknown[I];
 					ps->values[nnz++] = L;
-				} else if (f->dirichlet[I]) {
-					b -= L * f->dp[I];
+				} else if (si->dirichlet[I]) {
+					b -= L * si->dp[I];
 				}
 			}
 		ps->b[col] = b;
@@ -412,7 +421,8 @@ static idx_t build_reduced_system(struct sim *s, double diagonal_mean)
 /* The mean of the matrix's positive diagonal entries: the scale of the surface penalty. */
 static double mean_diagonal(const struct sim *s)
 {
-	const struct pressure_system *ps = &s->ps;
+	struct semi_implicit *si = semi_implicit_of(s);
+	const struct pressure_system *ps = &si->ps;
 	const int W = ps->width, centre = ps->radius + ps->radius * W;
 	double sum = 0.0;
 	idx_t count = 0;
@@ -426,13 +436,14 @@ static double mean_diagonal(const struct sim *s)
 
 enum poro_status pressure_solve(struct sim *s)
 {
-	struct pressure_system *ps = &s->ps;
+	struct semi_implicit *si = semi_implicit_of(s);
+	struct pressure_system *ps = &si->ps;
 	const struct particles *p = &s->soil, *w = &s->water;
 	double t0 = sim_clock();
 	memset(ps->stencil, 0, sizeof(double) * (size_t)s->grid.node_count * ps->width * ps->width);
 	double diagonal_mean = 0.0;
 	if (ps->exact) {
-		memset(s->f.rhs, 0, sizeof(double) * (size_t)s->grid.node_count);
+		memset(si->rhs, 0, sizeof(double) * (size_t)s->grid.node_count);
 		assemble_exact_projection(s);
 		if (ps->samples)   /* the interpolated free surface's scale, before any penalty */
 			diagonal_mean = mean_diagonal(s);
@@ -448,7 +459,7 @@ enum poro_status pressure_solve(struct sim *s)
 		scale_by_mobility_ratio(s, w, s->water_coef, s->water_scalar);
 		assemble_laplacian(s, p, s->soil_coef);
 		assemble_laplacian(s, w, s->water_coef);
-		pressure_divergence_rhs(s, s->f.v_s_star, s->f.v_w_star, s->f.rhs);
+		pressure_divergence_rhs(s, si->v_s_star, si->v_w_star, si->rhs);
 	}
 	cavitation_add_storage(s);   /* cavitation.c */
 	idx_t n = build_reduced_system(s, diagonal_mean);
@@ -461,6 +472,6 @@ enum poro_status pressure_solve(struct sim *s)
 		return st;
 	for (idx_t I = 0; I < s->grid.node_count; I++)
 		if (ps->unknown[I] >= 0)
-			s->f.dp[I] = ps->x[ps->unknown[I]];
-	return s->plate_work ? plate_couple_pressure(s, n) : PORO_OK;   /* rigid plates: plate.c */
+			si->dp[I] = ps->x[ps->unknown[I]];
+	return si->plate_work ? plate_couple_pressure(s, n) : PORO_OK;   /* rigid plates: plate.c */
 }

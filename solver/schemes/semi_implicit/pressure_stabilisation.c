@@ -35,12 +35,13 @@
  * field inside (a ghost penalty: it vanishes for pressures linear along the line). A ghost node
  * no such line reaches is held at zero.
  */
-#include "sim_internal.h"
+#include "semi_implicit.h"
 
 /* Node K is a pressure unknown: active (positive diagonal) and not prescribed. */
 static int is_unknown(const struct sim *s, const double *diagonal, idx_t K)
 {
-	return diagonal[K] > 0.0 && !s->f.dirichlet[K];
+	struct semi_implicit *si = semi_implicit_of(s);
+	return diagonal[K] > 0.0 && !si->dirichlet[K];
 }
 
 /* Marks the nodes whose neighbourhood of radius `margin` (inside the grid) holds only pressure
@@ -49,6 +50,7 @@ static int is_unknown(const struct sim *s, const double *diagonal, idx_t K)
  * a cell as it does next to a prescribed node. */
 static void mark_interior(const struct sim *s, const double *diagonal, int margin, signed char *interior)
 {
+	struct semi_implicit *si = semi_implicit_of(s);
 	const struct grid *g = &s->grid;
 	const idx_t nx = g->nodes[0], ny = g->nodes[1];
 	for (idx_t K = 0; K < g->node_count; K++) {
@@ -57,13 +59,14 @@ static void mark_interior(const struct sim *s, const double *diagonal, int margi
 		for (idx_t b = j - margin; inside && b <= j + margin; b++)
 			for (idx_t a = i - margin; inside && a <= i + margin; a++)
 				if (a >= 0 && a < nx && b >= 0 && b < ny)
-					inside = is_unknown(s, diagonal, a + b * nx) && !s->f.surface[a + b * nx];
+					inside = is_unknown(s, diagonal, a + b * nx) && !si->surface[a + b * nx];
 		interior[K] = (signed char)inside;
 	}
 }
 
 void pressure_stabilise(struct sim *s)
 {
+	struct semi_implicit *si = semi_implicit_of(s);
 	const struct case_formulation *form = &s->spec->formulation;
 	const int weak = form->free_surface == FREE_SURFACE_WEAK;
 	const int inner = form->pressure_stabilisation == PRESSURE_STABILISATION_SECOND_DIFFERENCE;
@@ -71,7 +74,7 @@ void pressure_stabilise(struct sim *s)
 		return;
 	const struct grid *g = &s->grid;
 	struct grid_fields *f = &s->f;
-	struct pressure_system *ps = &s->ps;
+	struct pressure_system *ps = &si->ps;
 	const int W = ps->width, centre = ps->radius + ps->radius * W;
 	const idx_t nx = g->nodes[0], ny = g->nodes[1];
 	for (idx_t K = 0; K < g->node_count; K++)   /* A's diagonal before any penalty */
@@ -86,14 +89,14 @@ void pressure_stabilise(struct sim *s)
 			if (d == 0 ? i == 0 || i == nx - 1 : j == 0 || j == ny - 1)
 				continue;
 			const idx_t line[3] = {J - step, J, J + step};
-			const int ghost = weak && (f->surface[line[0]] >= SURFACE_GHOST ||
-						   f->surface[line[1]] >= SURFACE_GHOST ||
-						   f->surface[line[2]] >= SURFACE_GHOST) &&
+			const int ghost = weak && (si->surface[line[0]] >= SURFACE_GHOST ||
+						   si->surface[line[1]] >= SURFACE_GHOST ||
+						   si->surface[line[2]] >= SURFACE_GHOST) &&
 					  is_unknown(s, ps->diagonal, line[0]) && is_unknown(s, ps->diagonal, line[1]) &&
 					  is_unknown(s, ps->diagonal, line[2]);
 			for (int a = 0; ghost && a < 3; a++)
-				if (f->surface[line[a]] == SURFACE_GHOST)
-					f->surface[line[a]] = SURFACE_GHOST_TIED;
+				if (si->surface[line[a]] == SURFACE_GHOST)
+					si->surface[line[a]] = SURFACE_GHOST_TIED;
 			const int interior = inner && ps->interior[line[0]] && ps->interior[line[1]] &&
 					     ps->interior[line[2]];
 			if (!ghost && !interior)
@@ -101,7 +104,7 @@ void pressure_stabilise(struct sim *s)
 			const double w = form->pressure_stabilisation_factor * ps->diagonal[J] / 6.0;
 			const double d2 = f->pressure[line[0]] - 2.0 * f->pressure[line[1]] + f->pressure[line[2]];
 			for (int a = 0; a < 3; a++) {
-				f->rhs[line[a]] -= w * c[a] * d2;   /* the p^t part of p^t + dp */
+				si->rhs[line[a]] -= w * c[a] * d2;   /* the p^t part of p^t + dp */
 				double *row = ps->stencil + (size_t)line[a] * W * W + centre;
 				for (int b = 0; b < 3; b++)
 					row[(b - a) * offset] += w * c[a] * c[b];
@@ -109,6 +112,6 @@ void pressure_stabilise(struct sim *s)
 		}
 	}
 	for (idx_t K = 0; weak && K < g->node_count; K++)
-		if (f->surface[K] == SURFACE_GHOST)   /* no line ties it to the field: held at zero */
-			f->dirichlet[K] = 1;
+		if (si->surface[K] == SURFACE_GHOST)   /* no line ties it to the field: held at zero */
+			si->dirichlet[K] = 1;
 }

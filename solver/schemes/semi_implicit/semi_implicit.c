@@ -38,24 +38,75 @@
  * every formula below serves both variants; only the water points' own motion differs.
  */
 #include <math.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include "phase_coupling.h"
 #include "phases.h"
+#include "scheme.h"
+#include "semi_implicit.h"
 #include "transfer.h"
 
+/* The scheme's nodal arrays of doubles with their widths and whether the step's reset zeroes them
+ * (drag_dt and mobility_ratio are written at every node before they are read). */
+#define SEMI_IMPLICIT_NODAL_FIELDS(X)                                                               \
+	X(v_s_star, DIM, 1) X(v_w_star, DIM, 1) X(drag_dt, 1, 0) X(mobility_ratio, 1, 0) X(dp, 1, 1)   \
+	X(rhs, 1, 1) X(correction_s, DIM, 1) X(correction_w, DIM, 1)
+
+static void destroy(struct sim *s)
+{
+	struct semi_implicit *si = semi_implicit_of(s);
+	if (!si)
+		return;
+	pressure_system_release(&si->ps);
+#define FREE(name, width, reset) free(si->name);
+	SEMI_IMPLICIT_NODAL_FIELDS(FREE)
+#undef FREE
+	free(si->cell_wet);
+	free(si->dirichlet);
+	free(si->surface);
+	free(si->cell_fill);
+	free(si->cell_fill_soil);
+	free(si->plate_work);
+	free(si);
+	s->scheme_state = NULL;
+}
+
+static enum poro_status create(struct sim *s)
+{
+	const struct case_formulation *form = &s->spec->formulation;
+	const size_t nodes = (size_t)s->grid.node_count, cells = (size_t)s->grid.cell_count;
+	struct semi_implicit *si = calloc(1, sizeof *si);
+	if (!(s->scheme_state = si))
+		return poro_error_set(&s->err, PORO_ENOMEM, "cannot allocate the semi-implicit scheme's state");
+	int ok = 1;
+#define ALLOC(name, width, reset) if (ok) ok = (si->name = calloc(nodes * (width), sizeof(double))) != NULL;
+	SEMI_IMPLICIT_NODAL_FIELDS(ALLOC)
+#undef ALLOC
+	ok = ok && (si->cell_wet = calloc(cells, 1)) && (si->dirichlet = calloc(nodes, 1)) &&
+	     (si->surface = calloc(nodes, 1)) && (si->cell_fill = calloc(cells, sizeof(double))) &&
+	     (si->cell_fill_soil = calloc(cells, sizeof(double)));
+	int plates = 0;
+	for (int f = 0; f < FACE_COUNT; f++)
+		plates += s->spec->boundaries[f].soil == CONSTRAINT_PLATE;
+	if (ok && plates)
+		ok = (si->plate_work = calloc((size_t)(FACE_COUNT + 2) * nodes, sizeof(double))) != NULL;
+	if (!ok)
+		return poro_error_set(&s->err, PORO_ENOMEM, "cannot allocate the semi-implicit scheme's grid of %ld nodes",
+				      (long)nodes);
+	return pressure_system_init(&si->ps, &s->grid, s->soil.support, form->pressure_projection,
+				    form->free_surface != FREE_SURFACE_NODES, &s->err);
+}
+
+/* Step 2's reset: the grid carries nothing from the last step (000 §4.5). */
 static void reset_grid(struct sim *s)
 {
+	struct semi_implicit *si = semi_implicit_of(s);
 	const size_t n = (size_t)s->grid.node_count;
-	struct grid_fields *f = &s->f;
-	double *scalars[] = {f->mass_s, f->mass_w, f->mass_w_points, f->mass_w_v, f->volume_s, f->porosity,
-			     f->conductivity, f->pressure, f->dp, f->rhs};
-	double *vectors[] = {f->v_s, f->v_w, f->v_s_old, f->v_w_old, f->v_s_star, f->v_w_star,
-			     f->force_w, f->force, f->correction_s, f->correction_w, f->du_s};
-	for (size_t i = 0; i < sizeof scalars / sizeof *scalars; i++)
-		memset(scalars[i], 0, n * sizeof(double));
-	for (size_t i = 0; i < sizeof vectors / sizeof *vectors; i++)
-		memset(vectors[i], 0, 2 * n * sizeof(double));
+	grid_fields_reset(&s->f, &s->grid);
+#define ZERO(name, width, reset) if (reset) memset(si->name, 0, n * (width) * sizeof(double));
+	SEMI_IMPLICIT_NODAL_FIELDS(ZERO)
+#undef ZERO
 }
 
 /* Step 2f's nodal pressure p^t. With the Laplacian, p^{t+1} = p^t + dp and the solve removes only
@@ -67,7 +118,8 @@ static void reset_grid(struct sim *s)
  * drops out there and the mean stays (docs/numerics.md, "Water at rest under gravity"). */
 static enum nodal_pressure nodal_pressure_of(const struct sim *s)
 {
-	return s->ps.exact ? NODAL_PRESSURE_MEAN : NODAL_PRESSURE_LINEAR_FIT;
+	struct semi_implicit *si = semi_implicit_of(s);
+	return si->ps.exact ? NODAL_PRESSURE_MEAN : NODAL_PRESSURE_LINEAR_FIT;
 }
 
 /* Steps 3-4: the water and soil predictors (Eqs. 52-53 with Eqs. 54-59).
@@ -97,16 +149,17 @@ static double soil_fraction(const struct grid_fields *f, idx_t I)
 
 static void predict_velocities(struct sim *s)
 {
+	struct semi_implicit *si = semi_implicit_of(s);
 	struct grid_fields *f = &s->f;
 	const struct particles *p = &s->soil, *w = &s->water;
 	const double dt = s->dt;
 	p2g_internal_force(&s->grid, p, p->volume, p->stress, NULL, f->force);
-	if (s->ps.exact) {
+	if (si->ps.exact) {
 		/* pressure forces through the same G the correction uses: G_w p^t and (G_s + G_w) p^t */
 		pressure_gradient_operators(s);
-		pressure_apply_gradient(s, s->ps.grad_w, f->pressure, f->force_w);
-		pressure_apply_gradient(s, s->ps.grad_w, f->pressure, f->force);
-		pressure_apply_gradient(s, s->ps.grad_s, f->pressure, f->force);
+		pressure_apply_gradient(s, si->ps.grad_w, f->pressure, f->force_w);
+		pressure_apply_gradient(s, si->ps.grad_w, f->pressure, f->force);
+		pressure_apply_gradient(s, si->ps.grad_s, f->pressure, f->force);
 	} else {
 		p2g_internal_force(&s->grid, w, w->volume, NULL, w->pressure, f->force_w);
 		p2g_internal_force(&s->grid, w, w->volume, NULL, w->pressure, f->force);
@@ -120,7 +173,7 @@ static void predict_velocities(struct sim *s)
 		for (int c = 0; c < 2; c++) {
 			const int k = 2 * I + c;
 			/* Eq. 56 is M_wI b; Eq. 57 carries the nodal porosity; Eq. 54 adds M_s b */
-			const double Fw = (s->ps.exact ? 1.0 : n) * f->force_w[k] + Mw * s->gravity[c];
+			const double Fw = (si->ps.exact ? 1.0 : n) * f->force_w[k] + Mw * s->gravity[c];
 			const double F = f->force[k] + (Ms + Mw) * s->gravity[c];
 			f->force_w[k] = Fw;
 			f->force[k] = F;
@@ -130,13 +183,13 @@ static void predict_velocities(struct sim *s)
 			const struct phase_coupling K = phase_coupling_inverse(Ms, Mw, Q * dt, f->fix_s[I] & (1 << c),
 									       f->fix_w[I] & (1 << c));
 			const double r_s = Ms * f->v_s[k] + dt * (F - Fw), r_w = Mw * f->v_w[k] + dt * Fw;
-			f->v_s_star[k] = K.ss * r_s + K.sw * r_w;
-			f->v_w_star[k] = K.sw * r_s + K.ww * r_w;
+			si->v_s_star[k] = K.ss * r_s + K.sw * r_w;
+			si->v_w_star[k] = K.sw * r_s + K.ww * r_w;
 		}
-		f->drag_dt[I] = Q * dt;
+		si->drag_dt[I] = Q * dt;
 	}
-	boundary_apply(&s->grid, f->fix_w, f->v_w_star);   /* (3e) */
-	boundary_apply(&s->grid, f->fix_s, f->v_s_star);   /* (4d) */
+	boundary_apply(&s->grid, f->fix_w, si->v_w_star);   /* (3e) */
+	boundary_apply(&s->grid, f->fix_s, si->v_s_star);   /* (4d) */
 	plate_predict(s);                                  /* rigid plates: their walls move with V* */
 }
 
@@ -150,6 +203,7 @@ static void predict_velocities(struct sim *s)
  * Off by default while its effect on the verification cases is measured (docs/numerics.md). */
 static void correct_velocities(struct sim *s)
 {
+	struct semi_implicit *si = semi_implicit_of(s);
 	struct grid_fields *f = &s->f;
 	const struct grid *g = &s->grid;
 	const int drag = s->spec->formulation.drag_in_correction;
@@ -157,24 +211,24 @@ static void correct_velocities(struct sim *s)
 	 * a sum over the points cannot rebuild; G also carries the nodal porosity factors */
 	const int weak = s->spec->formulation.free_surface == FREE_SURFACE_WEAK;
 	if (weak) {
-		memset(f->correction_s, 0, 2 * sizeof(double) * (size_t)g->node_count);
-		memset(f->correction_w, 0, 2 * sizeof(double) * (size_t)g->node_count);
-		pressure_apply_gradient(s, s->ps.grad_s, f->dp, f->correction_s);
-		pressure_apply_gradient(s, s->ps.grad_w, f->dp, f->correction_w);
+		memset(si->correction_s, 0, 2 * sizeof(double) * (size_t)g->node_count);
+		memset(si->correction_w, 0, 2 * sizeof(double) * (size_t)g->node_count);
+		pressure_apply_gradient(s, si->ps.grad_s, si->dp, si->correction_s);
+		pressure_apply_gradient(s, si->ps.grad_w, si->dp, si->correction_w);
 	} else {
-		p2g_point_gradient(g, &s->soil, s->soil.volume, f->dp, f->correction_s);
-		p2g_point_gradient(g, &s->water, s->water.volume, f->dp, f->correction_w);
+		p2g_point_gradient(g, &s->soil, s->soil.volume, si->dp, si->correction_s);
+		p2g_point_gradient(g, &s->water, s->water.volume, si->dp, si->correction_w);
 	}
 	for (idx_t I = 0; I < g->node_count; I++) {
 		const double n = f->porosity[I], share_s = weak ? 1.0 : 1.0 - n, share_w = weak ? 1.0 : n;
 		for (int c = 0; c < 2; c++) {
 			const int k = 2 * I + c;
 			const struct phase_coupling K = phase_coupling_inverse(
-				f->mass_s[I], f->mass_w[I], drag ? f->drag_dt[I] : 0.0, f->fix_s[I] & (1 << c),
+				f->mass_s[I], f->mass_w[I], drag ? si->drag_dt[I] : 0.0, f->fix_s[I] & (1 << c),
 				f->fix_w[I] & (1 << c));
-			const double f_s = s->dt * share_s * f->correction_s[k], f_w = s->dt * share_w * f->correction_w[k];
-			f->v_s[k] = f->mass_s[I] > 0.0 ? f->v_s_star[k] + K.ss * f_s + K.sw * f_w : 0.0;
-			f->v_w[k] = f->mass_w[I] > 0.0 ? f->v_w_star[k] + K.sw * f_s + K.ww * f_w : 0.0;
+			const double f_s = s->dt * share_s * si->correction_s[k], f_w = s->dt * share_w * si->correction_w[k];
+			f->v_s[k] = f->mass_s[I] > 0.0 ? si->v_s_star[k] + K.ss * f_s + K.sw * f_w : 0.0;
+			f->v_w[k] = f->mass_w[I] > 0.0 ? si->v_w_star[k] + K.sw * f_s + K.ww * f_w : 0.0;
 		}
 	}
 	boundary_apply(g, f->fix_w, f->v_w);
@@ -186,6 +240,7 @@ static void correct_velocities(struct sim *s)
  * many water points lie beyond a grid face (for point_motion_remove_outflow). */
 static idx_t update_points(struct sim *s)
 {
+	struct semi_implicit *si = semi_implicit_of(s);
 	struct grid_fields *f = &s->f;
 	idx_t water_beyond;
 	point_motion_update(s, &s->soil, f->v_s, f->v_s_old,
@@ -198,11 +253,11 @@ static idx_t update_points(struct sim *s)
 		/* 7c with 9a: p^{t+1}_I = p^t_I + dp_I, p^t_I being the smoothed nodal pressure of
 		 * step 2 (Eq. 77's inner sum), interpolated back to the points (Eq. 77's outer sum) */
 		for (idx_t I = 0; I < s->grid.node_count; I++)   /* free surface, drained faces: 0 */
-			f->pressure[I] = f->dirichlet[I] && !s->ps.exact ? 0.0 : f->pressure[I] + f->dp[I];
+			f->pressure[I] = si->dirichlet[I] && !si->ps.exact ? 0.0 : f->pressure[I] + si->dp[I];
 		g2p_scalar(&s->grid, &s->water, f->pressure, s->water.pressure);
 	} else {
 		/* unsmoothed: each point keeps its pressure and adds the interpolated increment */
-		g2p_scalar(&s->grid, &s->water, f->dp, s->water_scalar);
+		g2p_scalar(&s->grid, &s->water, si->dp, s->water_scalar);
 		for (idx_t q = 0; q < s->water.n; q++)
 			s->water.pressure[q] += s->water_scalar[q];
 	}
@@ -272,3 +327,10 @@ enum poro_status semi_implicit_step(struct sim *s)
 	s->step++;
 	return PORO_OK;
 }
+
+const struct scheme semi_implicit_scheme = {
+	.name = "semi_implicit",
+	.create = create,
+	.destroy = destroy,
+	.step = semi_implicit_step,
+};
