@@ -76,17 +76,52 @@ int hdf5_group_create(hid_t loc, const char *path, size_t heap_hint)
 	return rc;
 }
 
-int hdf5_dataset_write(hid_t loc, const char *path, hsize_t n, hsize_t width, hid_t file_type, hid_t mem_type,
-		       const void *data)
+/* The dataset creation properties of hdf5_dataset_write_compressed: chunks of whole rows, at most
+ * HDF5_CHUNK_BYTES each, shuffled and deflated at `level`. */
+static hid_t compressed_layout(hsize_t n, hsize_t width, size_t element, int level)
+{
+	hsize_t rows = HDF5_CHUNK_BYTES / (width * element);
+	hsize_t chunk[2] = {rows < 1 ? 1 : rows < n ? rows : n, width};
+	hid_t dcpl = H5Pcreate(H5P_DATASET_CREATE);
+	if (dcpl >= 0 && (H5Pset_chunk(dcpl, width == 1 ? 1 : 2, chunk) < 0 || H5Pset_shuffle(dcpl) < 0 ||
+			  H5Pset_deflate(dcpl, (unsigned)level) < 0)) {
+		H5Pclose(dcpl);
+		return -1;
+	}
+	return dcpl;
+}
+
+/* A dataset of n rows x width with creation properties dcpl (H5P_DEFAULT: contiguous). */
+static int dataset_write(hid_t loc, const char *path, hsize_t n, hsize_t width, hid_t file_type, hid_t mem_type,
+			 const void *data, hid_t dcpl)
 {
 	hsize_t dims[2] = {n, width};
 	hid_t space = H5Screate_simple(width == 1 ? 1 : 2, dims, NULL);
 	if (space < 0)
 		return -1;
-	hid_t ds = H5Dcreate2(loc, path, file_type, space, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
+	hid_t ds = H5Dcreate2(loc, path, file_type, space, H5P_DEFAULT, dcpl, H5P_DEFAULT);
 	int rc = ds < 0 || (n > 0 && H5Dwrite(ds, mem_type, H5S_ALL, H5S_ALL, H5P_DEFAULT, data) < 0) ? -1 : 0;
 	if (ds >= 0 && H5Dclose(ds) < 0)
 		rc = -1;
 	H5Sclose(space);
+	return rc;
+}
+
+int hdf5_dataset_write(hid_t loc, const char *path, hsize_t n, hsize_t width, hid_t file_type, hid_t mem_type,
+		       const void *data)
+{
+	return dataset_write(loc, path, n, width, file_type, mem_type, data, H5P_DEFAULT);
+}
+
+int hdf5_dataset_write_compressed(hid_t loc, const char *path, hsize_t n, hsize_t width, hid_t file_type,
+				  hid_t mem_type, const void *data, int level)
+{
+	if (n == 0 || level <= 0)   /* a chunk cannot be empty; level 0 asks for none */
+		return hdf5_dataset_write(loc, path, n, width, file_type, mem_type, data);
+	hid_t dcpl = compressed_layout(n, width, H5Tget_size(file_type), level);
+	if (dcpl < 0)
+		return -1;
+	int rc = dataset_write(loc, path, n, width, file_type, mem_type, data, dcpl);
+	H5Pclose(dcpl);
 	return rc;
 }

@@ -28,4 +28,11 @@ int hdf5_group_create(hid_t loc, const char *path, size_t heap_hint);
 int hdf5_dataset_write(hid_t loc, const char *path, hsize_t n, hsize_t width, hid_t file_type, hid_t mem_type,
 		       const void *data);
 
+/* The same, stored in chunks of whole rows of at most HDF5_CHUNK_BYTES, byte-shuffled and
+ * deflated (gzip) at level 1-9; every HDF5 reader (h5py, ParaView, MATLAB) decodes it with the
+ * zlib filter HDF5 is built with. level 0 or n = 0 writes a contiguous dataset. */
+#define HDF5_CHUNK_BYTES (1 << 20)
+int hdf5_dataset_write_compressed(hid_t loc, const char *path, hsize_t n, hsize_t width, hid_t file_type,
+				  hid_t mem_type, const void *data, int level);
+
 #endif

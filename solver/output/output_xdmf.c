@@ -2,10 +2,18 @@
  * output_xdmf.c - result.xdmf, the XDMF 3 index through which ParaView opens result.h5 (see
  * output_xdmf.h; the layout for users is schemas/results.md).
  *
- * Shape of the file: one Temporal collection; each frame is a Spatial collection carrying the
- * frame's <Time> and one Uniform grid per point set, "soil" and, in double point, "water". A grid
+ * Shape of the file: one Temporal collection per point set, "soil" and, in double point, "water";
+ * each holds one Uniform grid per frame, named after its set and carrying the frame's <Time>. So
+ * ParaView shows one block per set whose name is the same at every frame: with one Temporal
+ * collection of Spatial frames (the layout before) its readers named the blocks of later frames
+ * "soil[1]", "soil[2]", ..., and a block selection made at frame 0 came up empty after it. A grid
  * is a Polyvertex topology (n one-point cells, connectivity /xdmf/points_<n>), XY geometry from
  * <set>/x, and point attributes read straight from result.h5.
+ *
+ * Times are written with 15 significant digits: the frame at step k has t = k dt, which in binary
+ * is often a hair above its decimal value (9810 x 1e-4 = 0.9810000000000001), and ParaView, asked
+ * for t = 0.981, then showed the frame before. 15 digits give back the decimal time of any
+ * frame whose time has fewer, and result.h5 keeps the exact double.
  *
  * ParaView's XDMF 3 reader makes an attribute a vector only when it has 3 components, and it does
  * not read HyperSlab data items, so the grids read the copies that output.c writes for this
@@ -34,15 +42,16 @@ struct xdmf_attribute {
 	const char *dataset;  /* dataset in the set's group */
 	int width;            /* columns of the dataset (1: a 1-D dataset) */
 	int soil_only;        /* skeleton fields exist in soil/ only */
+	int water_carried;    /* in double point the water points carry it, and soil/ has none */
 };
 
 static const struct xdmf_attribute xdmf_attributes[] = {
-	{"pore_pressure", "Scalar", "pore_pressure", 1, 0},
-	{"porosity", "Scalar", "porosity", 1, 0},
-	{"displacement", "Vector", "displacement3", 3, 0},
-	{"v", "Vector", "v3", 3, 0},
-	{"stress", "Tensor", "stress9", 9, 1},
-	{"plastic_strain", "Scalar", "plastic_strain", 1, 1},
+	{"pore_pressure", "Scalar", "pore_pressure", 1, 0, 1},
+	{"porosity", "Scalar", "porosity", 1, 0, 0},
+	{"displacement", "Vector", "displacement3", 3, 0, 0},
+	{"v", "Vector", "v3", 3, 0, 0},
+	{"stress", "Tensor", "stress9", 9, 1, 0},
+	{"plastic_strain", "Scalar", "plastic_strain", 1, 1, 0},
 };
 
 /* An HDF5 data item: "n" or "n width" doubles of a dataset in result.h5. */
@@ -66,11 +75,14 @@ static void put_attribute(FILE *f, const char *set_path, const struct xdmf_attri
 	fprintf(f, "          </Attribute>\n");
 }
 
-static void put_grid(FILE *f, long index, const char *set, long n)
+/* One set's grid at one frame: double_point leaves out of the soil grid the attributes the water
+ * points carry (output.c writes no soil/pore_pressure in double point). */
+static void put_grid(FILE *f, long index, const char *set, long n, double time, int double_point)
 {
 	char set_path[64];
 	snprintf(set_path, sizeof set_path, OUTPUT_FRAME_FORMAT "/%s", index, set);
 	fprintf(f, "        <Grid Name=\"%s\" GridType=\"Uniform\">\n", set);
+	fprintf(f, "          <Time Value=\"%.15g\"/>\n", time);
 	fprintf(f, "          <Topology TopologyType=\"Polyvertex\" NumberOfElements=\"%ld\""
 		   " NodesPerElement=\"1\">\n", n);
 	fprintf(f, "            <DataItem Dimensions=\"%ld\" NumberType=\"Int\" Precision=\"4\" Format=\"HDF\">"
@@ -83,62 +95,79 @@ static void put_grid(FILE *f, long index, const char *set, long n)
 	fprintf(f, "          </Geometry>\n");
 	int soil = strcmp(set, "soil") == 0;
 	for (size_t i = 0; i < sizeof xdmf_attributes / sizeof xdmf_attributes[0]; i++)
-		if (soil || !xdmf_attributes[i].soil_only)
+		if ((soil || !xdmf_attributes[i].soil_only) && !(soil && double_point && xdmf_attributes[i].water_carried))
 			put_attribute(f, set_path, &xdmf_attributes[i], n);
 	fprintf(f, "        </Grid>\n");
 }
 
-/* A set without points is left out of the index: ParaView has no use for an empty grid. */
-static void put_frame(FILE *f, const struct xdmf_frame *fr)
-{
-	fprintf(f, "      <Grid Name=\"%06ld\" GridType=\"Collection\" CollectionType=\"Spatial\">\n",
-		fr->index);
-	fprintf(f, "        <Time Value=\"%.17g\"/>\n", fr->time);
-	if (fr->soil_n > 0)
-		put_grid(f, fr->index, "soil", fr->soil_n);
-	if (fr->water_n > 0)
-		put_grid(f, fr->index, "water", fr->water_n);
-	fprintf(f, "      </Grid>\n");
-}
-
-/* The file around the frames. */
-static const char xdmf_head[] =
-	"<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n"
-	"<Xdmf Version=\"3.0\">\n  <Domain>\n"
-	"    <Grid Name=\"frames\" GridType=\"Collection\" CollectionType=\"Temporal\">\n";
-static const char xdmf_tail[] = "    </Grid>\n  </Domain>\n</Xdmf>\n";
-
-enum poro_status xdmf_index_add(struct xdmf_index *x, const struct xdmf_frame *frame, struct poro_error *err)
+/* Formats one set's grid of a frame into *text (malloc'ed), or NULL when out of memory. */
+static char *format_grid(const struct xdmf_frame *fr, const char *set, long n, size_t *len)
 {
 	char *text = NULL;
-	size_t len = 0;
-	FILE *m = open_memstream(&text, &len);
-	if (m) {
-		put_frame(m, frame);
-		if (fclose(m) != 0) {
-			free(text);
-			text = NULL;
-		}
+	FILE *m = open_memstream(&text, len);
+	if (!m)
+		return NULL;
+	put_grid(m, fr->index, set, n, fr->time, fr->water_n >= 0);
+	if (fclose(m) != 0) {
+		free(text);
+		return NULL;
 	}
-	if (text && x->len + len > x->cap) {
+	return text;
+}
+
+/* Appends len bytes to a series' text; -1 when out of memory (the series is left as it was). */
+static int series_append(struct xdmf_series *x, const char *text, size_t len)
+{
+	if (x->len + len > x->cap) {
 		size_t cap = x->cap ? 2 * x->cap : 64 * 1024;
 		while (cap < x->len + len)
 			cap *= 2;
 		char *grown = realloc(x->text, cap);
-		if (grown) {
-			x->text = grown;
-			x->cap = cap;
-		}
-	}
-	if (!text || x->len + len > x->cap) {
-		free(text);
-		return poro_error_set(err, PORO_ENOMEM, "cannot allocate the xdmf index");
+		if (!grown)
+			return -1;
+		x->text = grown;
+		x->cap = cap;
 	}
 	memcpy(x->text + x->len, text, len);
 	x->len += len;
+	return 0;
+}
+
+/* A set without points at a frame is left out of its series there: ParaView has no use for an
+ * empty grid (a water series whose points have all drained ends at its last frame with water). */
+enum poro_status xdmf_index_add(struct xdmf_index *x, const struct xdmf_frame *frame, struct poro_error *err)
+{
+	size_t soil_len = 0, water_len = 0;
+	char *soil = frame->soil_n > 0 ? format_grid(frame, "soil", frame->soil_n, &soil_len) : NULL;
+	char *water = frame->water_n > 0 ? format_grid(frame, "water", frame->water_n, &water_len) : NULL;
+	int ok = (soil || frame->soil_n <= 0) && (water || frame->water_n <= 0);
+	const size_t soil_before = x->soil.len;
+	if (ok && soil)
+		ok = series_append(&x->soil, soil, soil_len) == 0;
+	if (ok && water && series_append(&x->water, water, water_len) != 0) {
+		x->soil.len = soil_before;   /* all of the frame or none of it */
+		ok = 0;
+	}
+	free(soil);
+	free(water);
+	if (!ok)
+		return poro_error_set(err, PORO_ENOMEM, "cannot allocate the xdmf index");
 	x->frames++;
-	free(text);
 	return PORO_OK;
+}
+
+/* The file around the series. */
+static const char xdmf_head[] = "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n"
+				"<Xdmf Version=\"3.0\">\n  <Domain>\n";
+static const char xdmf_tail[] = "  </Domain>\n</Xdmf>\n";
+
+static void put_series(FILE *f, const char *set, const struct xdmf_series *x)
+{
+	if (!x->len)
+		return;
+	fprintf(f, "    <Grid Name=\"%s\" GridType=\"Collection\" CollectionType=\"Temporal\">\n", set);
+	fwrite(x->text, 1, x->len, f);
+	fputs("    </Grid>\n", f);
 }
 
 static char *join(const char *dir, const char *name)
@@ -165,8 +194,8 @@ enum poro_status xdmf_index_write(const struct xdmf_index *x, const char *dir, s
 		goto out;
 	}
 	fputs(xdmf_head, f);
-	if (x->len)
-		fwrite(x->text, 1, x->len, f);
+	put_series(f, "soil", &x->soil);
+	put_series(f, "water", &x->water);
 	fputs(xdmf_tail, f);
 	/* fflush + fsync before rename: the new name must never point at data still in flight */
 	int failed = ferror(f) || fflush(f) != 0 || fsync(fileno(f)) != 0;
@@ -193,6 +222,7 @@ out:
 
 void xdmf_index_release(struct xdmf_index *x)
 {
-	free(x->text);
+	free(x->soil.text);
+	free(x->water.text);
 	*x = (struct xdmf_index){0};
 }

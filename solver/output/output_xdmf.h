@@ -29,11 +29,16 @@ struct xdmf_frame {
 	long water_n;     /* points in water/; -1 when the frame has no water group (single point) */
 };
 
+/* One point set's grids of the frames listed so far, formatted. */
+struct xdmf_series {
+	char *text;       /* [cap] the frames' <Grid> elements, not NUL terminated */
+	size_t len, cap;
+};
+
 /* The XML of the frames listed so far, kept so that a rewrite is one write, not a reformatting of
  * every frame (which would make a long run's output quadratic in formatting work). */
 struct xdmf_index {
-	char *text;       /* [cap] the frames' <Grid> elements, not NUL terminated */
-	size_t len, cap;
+	struct xdmf_series soil, water;
 	size_t frames;    /* frames listed */
 };
 

@@ -110,7 +110,8 @@ def values(d, path):
     return [float(x) for x in body.replace(",", " ").split()]
 
 def frame_times(d):
-    return [float(t) for t in re.findall(r'<Time Value="([^"]*)"', open(d + "/result.xdmf").read())]
+    xdmf = open(d + "/result.xdmf").read()   # the soil series' times: one per frame
+    return [float(t) for t in re.findall(r'<Grid Name="soil" GridType="Uniform">\s*<Time Value="([^"]*)"', xdmf)]
 
 def frame_groups(d):
     p = subprocess.run(["h5ls", d + "/result.h5/frames"], capture_output=True, text=True)
@@ -126,6 +127,11 @@ t_ref, t_res = frame_times(ref), frame_times(res)
 groups = frame_groups(res)
 report("resumed_frames_at_uninterrupted_times", t_ref == t_res and len(groups) == len(t_res),
        "times %s vs %s, %d groups" % (t_res, t_ref, len(groups)))
+# the index of frames is cut back with the frames and continued: it lists what the groups hold
+i_ref, i_res = values(ref, "/frame_times"), values(res, "/frame_times")
+s_ref, s_res = values(ref, "/frame_steps"), values(res, "/frame_steps")
+report("resumed_frame_index_as_uninterrupted", i_ref is not None and i_ref == i_res and s_ref == s_res and
+       len(i_res) == len(groups), "times %s vs %s, steps %s vs %s" % (i_res, i_ref, s_res, s_ref))
 
 t_ckpt = resumed_step * 1e-4
 worst = 0.0

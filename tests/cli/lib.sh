@@ -15,6 +15,8 @@
 #   derive_case NAME BASE PYTHON          $tmp/NAME.json: the case BASE after the python statement
 #                                         PYTHON run with c (the case)
 #   derive_element NAME BASE PYTHON       the same for an element case
+#   run_derived NAME LABEL                runs $tmp/NAME.json into $tmp/NAME; the check
+#                                         LABEL_exits_0
 #   expect_element_refused NAME FILE POINTER...
 #                                         `poro-solve element FILE` exits 2, names every POINTER and
 #                                         writes no element.csv
@@ -64,6 +66,13 @@ EOF2
 }
 
 derive_element() { derive_case "$@"; }
+
+run_derived() {
+	local rc
+	"$solve" run "$tmp/$1.json" --out "$tmp/$1" > /dev/null 2> "$tmp/err"
+	rc=$?
+	check "$2_exits_0" $rc "exit $rc: $(head -c 300 "$tmp/err")"
+}
 
 expect_element_refused() {
 	local name=$1 file=$2 rc ok=0 pointer
