@@ -15,7 +15,10 @@
  *
  * Definitions (h = the case's grid cell_size; "soil points" are the rows of a frame's soil set):
  *   toe_x        largest x of the soil points with y > ground + tolerance; NaN when there is none.
- *   runout       toe_x(t) - toe_x(first frame).
+ *   runout       front_x(t) - front_x(first frame): how far the soil that came from the slope
+ *                travelled. (It was toe_x(t) - toe_x(first frame), which counted foundation soil
+ *                heaved in front of the toe: 6.80 m on tests/cases/mc_slope_k1e-3_double_point.json,
+ *                where no soil point moved more than 1.09 m; 0.55 m by the slope's own soil.)
  *   front_x      largest x of the soil points seeded above the ground, those whose reference
  *                position y - displacement_y > ground + tolerance: the front of the soil that
  *                came from the slope, blind to foundation soil heaved in front of the toe (which

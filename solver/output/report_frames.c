@@ -200,7 +200,7 @@ enum poro_status report_frames(struct report *rep, struct report_row **out, long
 	for (long k = 0; !st && k < rep->frames; k++)
 		st = frame_row(rep, k, &rows[k], &top[k], err);
 	for (long k = 0; !st && k < rep->frames; k++) {
-		rows[k].runout = rows[k].toe_x - rows[0].toe_x;
+		rows[k].runout = rows[k].front_x - rows[0].front_x;   /* report.h: the slope's own soil */
 		rows[k].crest_settlement = top[0] - top[k];
 	}
 	free(top);
