@@ -36,7 +36,7 @@ TEST_BIN   = $(TEST_SRC:%.c=$(BUILD)/%)
 COMMON_TEST_BIN = $(patsubst %.c,$(BUILD)/%,$(wildcard tests/common/*_test.c))
 BENCH_SRC  = $(wildcard bench/*_bench.c)
 BENCH_BIN  = $(BENCH_SRC:%.c=$(BUILD)/%)
-TOOLS      = $(BUILD)/terzaghi-error
+TOOLS      = $(BUILD)/terzaghi-error $(BUILD)/poro-plot
 
 # The service (docs/service.md): server, worker, user CLI and load generator. Each external library
 # enters through one file: libmicrohttpd (server/http.c), SQLite (server/store*.c), libcurl
@@ -103,6 +103,12 @@ $(BUILD)/terzaghi-error: $(BUILD)/tools/terzaghi_error.o $(LIBPORO)
 	$(CC) $(LDFLAGS) $^ $(LDLIBS) -o $@
 
 $(BUILD)/tools/terzaghi_error.o: tests/verify/analytic.h
+
+# poro-plot is a Python program (matplotlib, h5py): "built" by copying it beside poro-solve, which
+# it calls for the run-out picture.
+$(BUILD)/poro-plot: cli/poro_plot.py
+	@mkdir -p $(dir $@)
+	cp $< $@ && chmod +x $@
 
 $(BUILD)/tests/%: $(BUILD)/tests/%.o $(LIBPORO)
 	$(CC) $(LDFLAGS) $^ $(LDLIBS) -o $@

@@ -7,7 +7,7 @@
  *                                        "schema"); every problem as "JSON-pointer: message"
  *   poro-solve element CASE.json --out DIR
  *                                        single-element triaxial test (element.h, docs/element.md):
- *                                        DIR/element.csv and DIR/element.svg
+ *                                        DIR/element.csv (poro-plot draws it)
  *   poro-solve report RESULT.h5 [--out FILE] [--ground Y] [--crest X] [--tolerance M]
  *                     [--line X0,Y0,X1,Y1[,...][,N] --line-out FILE [--at TIME]]
  *                                        derived quantities of a run (report.h, docs/report.md): a
@@ -134,7 +134,7 @@ static int cmd_element(const char *path, const char *out_dir)
 	const struct element_row *last = &r.row[r.rows - 1];
 	printf("%d steps: axial strain %.6g, p = %.6g Pa, q = %.6g Pa, volumetric strain %.6g\n", r.rows - 1,
 	       last->axial_strain, last->p, last->q, last->volumetric_strain);
-	printf("done: %s/element.csv, %s/element.svg\n", out_dir, out_dir);
+	printf("done: %s/element.csv (pictures: poro-plot %s/element.csv)\n", out_dir, out_dir);
 	element_result_release(&r);
 	return 0;
 }

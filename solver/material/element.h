@@ -75,8 +75,8 @@ struct element_result {
 enum poro_status element_run(const struct element_case *c, struct element_result *r, struct poro_error *err);
 void element_result_release(struct element_result *r);
 
-/* Writes DIR/element.csv (header axial_strain,p,q,volumetric_strain then the model's outputs) and
- * DIR/element.svg (q against p, q against axial strain), creating DIR if needed (element_output.c). */
+/* Writes DIR/element.csv (header axial_strain,p,q,volumetric_strain then the model's outputs),
+ * creating DIR if needed (element_output.c); `poro-plot DIR/element.csv` draws it. */
 enum poro_status element_write(const struct element_case *c, const struct element_result *r, const char *dir,
 			       struct poro_error *err);
 

@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # element_test.sh - drives `poro-solve element` and `poro-solve validate` with the Mohr-Coulomb
 # family: every element case in tests/cases/ runs end to end (exit 0, element.csv with its header
-# row and one row per step, element.svg well-formed XML by python3's xml module); invalid material
+# row and one row per step; poro-plot draws it into element.svg, well-formed XML by python3's xml
+# module with the three panels' axis labels and the case's title as text); invalid material
 # parameters, in a simulation case (derived from tests/cases/terzaghi.json) and in an element case,
 # are refused with exit 2 and the JSON pointer of the value. Prints "PASS name" / "FAIL name: why".
 #   bash tests/cli/element_test.sh BUILD_DIR      (from the repository root)
@@ -22,6 +23,9 @@ for case in tests/cases/*.json; do
 	header=$(head -1 "$out/element.csv" 2>/dev/null)
 	case "$header" in axial_strain,p,q,volumetric_strain*) ok=0 ;; *) ok=1 ;; esac
 	check "element_${name}_csv_header" $ok "header '$header'"
+	"$build/poro-plot" "$out/element.csv" --case "$case" --format svg > /dev/null 2> "$tmp/err"
+	rc=$?
+	check "element_${name}_poro_plot_exits_0" "$rc" "exit $rc: $(head -c 300 "$tmp/err")"
 	python3 - "$case" "$out/element.csv" "$out/element.svg" <<'PY'
 import csv, json, sys, xml.etree.ElementTree as ET
 case = json.load(open(sys.argv[1]))
@@ -31,7 +35,10 @@ assert all(len(r) == len(rows[0]) for r in rows), "ragged rows"
 assert abs(float(rows[-1][0]) - case["axial_strain"]) <= 1e-9 * abs(case["axial_strain"]), "final axial strain"
 root = ET.parse(sys.argv[3]).getroot()
 assert root.tag == "{http://www.w3.org/2000/svg}svg", root.tag
-assert len(root.findall(".//{http://www.w3.org/2000/svg}polyline")) == 2, "two plots"
+text = " ".join(t.text or "" for t in root.iter("{http://www.w3.org/2000/svg}text"))
+for label in ("q against p", "q against axial strain", "volumetric strain", "p, mean effective stress (kPa)",
+              case.get("title", "single element")):
+    assert label in text, "no '%s' in the picture's text" % label
 PY
 	rc=$?
 	check "element_${name}_csv_rows_and_svg_xml" $rc "python3 check failed"
