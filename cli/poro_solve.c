@@ -94,6 +94,16 @@ static void print_progress(const struct sim_progress *p, void *user)
 	fflush(stdout);
 }
 
+/* A valid case's warnings (case.h), each line as "PATH: warning: POINTER: message" on stderr. */
+static void print_warnings(const char *path, const char *warnings)
+{
+	for (const char *line = warnings; *line;) {
+		size_t len = strcspn(line, "\n");
+		fprintf(stderr, "%s: warning: %.*s\n", path, (int)len, line);
+		line += len + (line[len] == '\n');
+	}
+}
+
 static int cmd_validate(const char *path)
 {
 	struct case_spec *c = NULL;
@@ -103,12 +113,14 @@ static int cmd_validate(const char *path)
 		enum poro_status st = element_case_load_file(path, &e, &err);
 		if (st)
 			return fail(st, &err, path);
+		print_warnings(path, e.warnings);
 		printf("%s: valid element case\n", path);
 		return 0;
 	}
 	enum poro_status st = case_load_file(path, &c, &err);
 	if (st)
 		return fail(st, &err, path);
+	print_warnings(path, c->warnings);
 	printf("%s: valid\n", path);
 	case_destroy(&c);
 	return 0;
@@ -124,6 +136,7 @@ static int cmd_element(const char *path, const char *out_dir)
 	enum poro_status st = element_case_load_file(path, &c, &err);
 	if (st)
 		return fail(st, &err, path);
+	print_warnings(path, c.warnings);
 	st = element_run(&c, &r, &err);
 	if (!st)
 		st = element_write(&c, &r, out_dir, &err);
@@ -163,6 +176,7 @@ static int cmd_run(const char *path, const struct run_options *opt)
 	enum poro_status st = case_load_file(path, &c, &err);
 	if (st)
 		return fail(st, &err, path);
+	print_warnings(path, c->warnings);
 	st = sim_create(&s, c, &err);
 	if (st) {
 		case_destroy(&c);

@@ -45,6 +45,10 @@
  * problems"). case_problem_count() reads the total back from such a message. */
 #define CASE_PROBLEMS_MAX 100
 #define CASE_PROBLEMS_MORE "... and "
+/* A valid case may still carry warnings: values that are allowed but most likely not what the
+ * author meant (a friction angle that reads as radians), one "JSON-pointer: message" line each, in
+ * case_spec.warnings (element_case.warnings), at most this many bytes with the NUL. */
+#define CASE_WARNINGS_SIZE 2048
 
 enum case_scheme { SCHEME_SEMI_IMPLICIT };
 enum case_phases { PHASES_DOUBLE_POINT, PHASES_SINGLE_POINT };
@@ -231,6 +235,7 @@ struct case_probe {
 
 struct case_spec {
 	char title[CASE_TITLE_MAX + 1];
+	char warnings[CASE_WARNINGS_SIZE]; /* "" when none (CASE_WARNINGS_SIZE) */
 	struct case_formulation formulation;
 	struct case_grid grid;
 	int material_count;

@@ -42,6 +42,22 @@ static void write_more_line(struct case_reader *r)
 		 CASE_PROBLEMS_MORE, more, more == 1 ? "" : "s");
 }
 
+void case_warn(struct case_reader *r, const char *pointer, const char *fmt, ...)
+{
+	if (!r->warnings)
+		return;
+	char message[PROBLEM_MAX];
+	va_list ap;
+	va_start(ap, fmt);
+	vsnprintf(message, sizeof message, fmt, ap);
+	va_end(ap);
+	size_t used = strlen(r->warnings);
+	int n = snprintf(r->warnings + used, CASE_WARNINGS_SIZE - used, "%s%s: %s", used ? "\n" : "",
+			 pointer[0] ? pointer : "/", message);
+	if (n < 0 || (size_t)n >= CASE_WARNINGS_SIZE - used)
+		r->warnings[used] = '\0';   /* a warning that does not fit is left out whole */
+}
+
 void case_problem(struct case_reader *r, const char *pointer, const char *fmt, ...)
 {
 	/* Only a prefix of the problems is recorded, so the list reads in document order. */

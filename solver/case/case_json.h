@@ -28,6 +28,7 @@ typedef struct json_t json_t;
 
 struct case_reader {
 	struct poro_error *err;     /* where problems go; may be NULL */
+	char *warnings;             /* [CASE_WARNINGS_SIZE] where warnings go (case.h); NULL: dropped */
 	int problem_count;          /* problems found so far */
 	int out_of_memory;          /* an allocation failed while reading */
 	int recorded;               /* problems written into err->message, a prefix of those found */
@@ -48,6 +49,10 @@ struct case_range {
 /* Counts one problem and records it as "pointer: message" while under the cap (case.h). */
 void case_problem(struct case_reader *r, const char *pointer, const char *fmt, ...)
 	__attribute__((format(printf, 3, 4)));
+
+/* Appends "pointer: message" as a line to r->warnings while it fits (case.h, CASE_WARNINGS_SIZE):
+ * a value that is valid but most likely not what the author meant. */
+void case_warn(struct case_reader *r, const char *pointer, const char *fmt, ...) __attribute__((format(printf, 3, 4)));
 
 /* Writes base + "/" + key (escaped per RFC 6901) or base + "/" + index into dst[CASE_POINTER_MAX]. */
 void case_pointer_key(char *dst, const char *base, const char *key);

@@ -747,7 +747,9 @@ static enum poro_status load_root(struct case_reader *r, const json_t *root, con
 	struct case_spec *c = calloc(1, sizeof *c);
 	if (c) {
 		set_defaults(c);
+		r->warnings = c->warnings;
 		read_case(r, root, c);
+		r->warnings = NULL;
 	}
 	if (c && !r->out_of_memory && !r->problem_count && !(c->json = text ? strdup(text) : case_json_text(root)))
 		r->out_of_memory = 1;

@@ -12,6 +12,8 @@
  */
 #include "case_material.h"
 
+#include <math.h>
+
 #define KEYS_MAX 48                         /* longest key list, with the caller's own keys */
 
 /* Softening no steeper than this multiple of the shear modulus G (Pa per unit deviatoric plastic
@@ -175,6 +177,21 @@ static void read_nor_sand(struct case_reader *r, const json_t *o, const char *p,
 	}
 }
 
+/* Angles are in degrees. A friction angle above 0 and below RADIANS_SUSPECT reads as radians
+ * (0.38, meant as 21.8 degrees, is a soil almost without friction): valid, but warned about. */
+#define RADIANS_SUSPECT 1.6
+#define RADIAN_IN_DEGREES 57.295779513082320877   /* 180 / pi */
+static void warn_if_radians(struct case_reader *r, const char *p, const char *key, int ok, double degrees)
+{
+	if (!ok || !(degrees > 0.0 && degrees < RADIANS_SUSPECT))
+		return;
+	char where[CASE_POINTER_MAX], text[CASE_NUMBER_SIZE], as_degrees[CASE_NUMBER_SIZE];
+	case_pointer_key(where, p, key);
+	case_warn(r, where, "%s degrees is almost no friction; angles are in degrees: if %s is in radians, "
+		  "write %s", case_format_number(text, degrees), text,
+		  case_format_number(as_degrees, round(degrees * RADIAN_IN_DEGREES * 100.0) / 100.0));
+}
+
 void case_read_material_model(struct case_reader *r, const json_t *o, const char *p,
 			      const char *const *extra_keys, struct case_material *m)
 {
@@ -211,6 +228,7 @@ void case_read_material_model(struct case_reader *r, const json_t *o, const char
 	}
 	case_read_number(r, o, p, "cohesion", CASE_REQUIRED, &NON_NEGATIVE, &m->cohesion);
 	int phi_ok = case_read_number(r, o, p, "friction_angle", CASE_REQUIRED, &FRICTION_ANGLE, &m->friction_angle);
+	warn_if_radians(r, p, "friction_angle", phi_ok, m->friction_angle);
 	if (model == MODEL_MOHR_COULOMB) {
 		read_dilation(r, o, p, "dilation_angle", 0, m->friction_angle, phi_ok, &m->dilation_angle);
 		return;

@@ -32,6 +32,7 @@ enum element_test { ELEMENT_DRAINED, ELEMENT_UNDRAINED };
 
 struct element_case {
 	char title[256];
+	char warnings[CASE_WARNINGS_SIZE]; /* "" when none (case.h) */
 	struct case_material material;    /* model and parameters (case_material.h keys) */
 	enum element_test test;           /* "drained" | "undrained" */
 	double confining_pressure;        /* cell pressure, Pa, >= 0 (compression positive) */

@@ -48,8 +48,8 @@ static void read_element(struct case_reader *r, const json_t *root, struct eleme
 
 enum poro_status element_case_load_string(const char *json, struct element_case *c, struct poro_error *err)
 {
-	struct case_reader r = { .err = err };
 	memset(c, 0, sizeof *c);
+	struct case_reader r = { .err = err, .warnings = c->warnings };
 	if (!json)
 		return poro_error_set(err, PORO_EINVAL, "/: no JSON text");
 	json_t *root = case_json_parse(&r, json);

@@ -89,6 +89,22 @@ grep -qx '\.\.\. and 900 more problems' "$tmp/err"
 check validate_caps_the_problems_and_counts_the_rest $(( rc != 2 || listed != 100 || $? != 0 )) \
 	"exit $rc, $listed problems listed, last line: $(tail -1 "$tmp/err")"
 
+# ---- a friction angle that reads as radians is valid but warned about, naming the key -------------
+# (0.38 written for 21.8 degrees is a soil almost without friction: nothing refuses it, so only a
+# warning tells the author; a case at 30 degrees gets none)
+
+for f in mc_slope_k1e-3_double_point mohr_coulomb_drained; do
+	python3 -c "import sys; open(sys.argv[2], 'w').write(open(sys.argv[1]).read().replace('\"friction_angle\": 30', '\"friction_angle\": 0.38'))" \
+		"tests/cases/$f.json" "$tmp/radians_$f.json"
+	"$solve" validate "$tmp/radians_$f.json" > /dev/null 2> "$tmp/err"
+	rc=$?
+	grep -q "warning: /materials\?/\(0/\)\?friction_angle: 0.38 degrees .* write 21.77$" "$tmp/err"
+	found=$?
+	"$solve" validate "tests/cases/$f.json" > /dev/null 2> "$tmp/err_degrees"
+	check "validate_${f}_warns_of_radians" $(( rc != 0 || found != 0 || $(grep -c warning "$tmp/err_degrees") != 0 )) \
+		"exit $rc, stderr: $(head -c 300 "$tmp/err"); in degrees: $(head -c 200 "$tmp/err_degrees")"
+done
+
 # ---- a file that does not exist: exit 4 naming the path ---------------------------------------
 
 absent="$tmp/no_such_case.json"
