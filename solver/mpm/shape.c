@@ -121,14 +121,20 @@ static inline double hat(double u)
 	return fmax(0.0, 1.0 - fabs(u));
 }
 
-/* uGIMP (Bardenhagen and Kober 2004): S_I(x_p) = (1/|D|) integral over the point's domain D of the
- * linear hat N_I, with D = [xi - lambda, xi + lambda] (lambda the half width in cells, at most 1/2)
- * clipped to the grid [0, cells]. Clipping keeps the partition of unity where a domain reaches
- * past the edge; inside the grid this is the familiar piecewise form (1 - (d^2 + lambda^2) /
- * (2 lambda) for |d| < lambda, 1 - |d| between, (1 + lambda - |d|)^2 / (4 lambda) in the outer
- * band, d = xi - I in cells). With a = max(xi - lambda, 0), b = min(xi + lambda, cells) and a', b'
- * their derivatives in xi (1, or 0 where clipped), dS/dxi = (N(b) b' - N(a) a' - S (b' - a')) /
- * (b - a). lambda = 0 gives the linear hat. */
+/* uGIMP (Bardenhagen and Kober 2004): the weight and gradient weight of a point with domain D are
+ * the means over D of the linear hat N_I and of its gradient,
+ *     S_I = (1/|D|) int_D N_I,      grad S_I = (1/|D|) int_D grad N_I = (N_I(b) - N_I(a)) / (b - a),
+ * with D = [xi - lambda, xi + lambda] (lambda the half width in cells, at most 1/2) clipped to the
+ * grid [0, cells] as [a, b]. The gradient weight is what the weak form's internal force
+ * f_I = -int sigma grad N_I dV asks for over each point's domain; inside the grid it is dS_I/dxi,
+ * the familiar piecewise form (1 - (d^2 + lambda^2) / (2 lambda) for |d| < lambda, 1 - |d|
+ * between, (1 + lambda - |d|)^2 / (4 lambda) in the outer band, d = xi - I in cells), but where a
+ * domain is clipped (or just touches the edge) it is not: the derivative of the clipped mean
+ * counts the domain shrinking as the point moves, which under a uniform stress put -0.75 sigma h
+ * of a wall row's force on the wall node and -0.25 sigma h on its neighbour, a quarter of the
+ * wall's reaction on a node no wall holds (docs/numerics.md, "Shape functions at the grid edges").
+ * The mean gradient gives -sigma h and 0, the gradient of a linear field exactly, and still sums
+ * to zero over the nodes. lambda = 0 gives the linear hat. */
 static inline int gimp_1d(double xi, double lambda, idx_t cells, double inv_h, idx_t *i0, double *w, double *dw)
 {
 	if (lambda <= 0.0) {             /* the hat itself, on 3 nodes that stay inside the grid */
@@ -144,7 +150,6 @@ static inline int gimp_1d(double xi, double lambda, idx_t cells, double inv_h, i
 		return 0;
 	}
 	const double a = fmax(xi - lambda, 0.0), b = fmin(xi + lambda, (double)cells);
-	const double da = xi - lambda > 0.0 ? 1.0 : 0.0, db = xi + lambda < (double)cells ? 1.0 : 0.0;
 	idx_t i = (idx_t)floor(a);        /* the domain [a, b], at most a cell long, meets nodes i .. i + 2 */
 	if (i > cells - 2)
 		i = cells - 2;              /* needs cells >= 2; the extra node then gets weight 0 */
@@ -152,7 +157,7 @@ static inline int gimp_1d(double xi, double lambda, idx_t cells, double inv_h, i
 	for (int k = 0; k < 3; k++) {
 		const double node = (double)(i + k);
 		w[k] = (hat_integral(b - node) - hat_integral(a - node)) / (b - a);
-		dw[k] = (hat(b - node) * db - hat(a - node) * da - w[k] * (db - da)) / (b - a) * inv_h;
+		dw[k] = (hat(b - node) - hat(a - node)) / (b - a) * inv_h;
 	}
 	return 0;
 }
