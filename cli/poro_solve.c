@@ -191,6 +191,9 @@ static int cmd_run(const char *path, const struct run_options *opt)
 	sim_set_checkpoint_wall(s, opt->checkpoint_wall);
 	printf("case '%s': %ld soil points, %ld water points, %ld steps\n", c->title,
 	       (long)sim_soil(s)->n, sim_is_double_point(s) ? (long)sim_water(s)->n : 0L, sim_steps_total(s));
+	if (c->time.dt_auto)
+		printf("dt \"auto\": %.6g s, the %s scheme's recommended step\n", c->time.dt,
+		       c->formulation.scheme == SCHEME_EXPLICIT ? "explicit" : "semi-implicit");
 	if (opt->resume)
 		printf("resumed from '%s' at step %ld, t = %.6g s\n", opt->resume, sim_steps_taken(s), sim_time(s));
 	signal(SIGTERM, on_signal);

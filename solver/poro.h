@@ -66,7 +66,9 @@ void sim_grid_masses(const struct sim *s, double *grid_soil, double *grid_water,
  * correction, grid-to-particle, kinematics, stress update. */
 enum sim_phase { PHASE_SHAPE, PHASE_P2G, PHASE_PREDICT, PHASE_PRESSURE_ASSEMBLY, PHASE_PRESSURE_SOLVE,
 		 PHASE_CORRECT, PHASE_G2P, PHASE_KINEMATICS, PHASE_STRESS, PHASE_COUNT };
-const char *sim_phase_name(enum sim_phase phase);
+const char *sim_phase_name(enum sim_phase phase);   /* the semi-implicit scheme's names */
+/* What the phase slot times in s's scheme; NULL for a slot the scheme does not use. */
+const char *sim_phase_name_of(const struct sim *s, enum sim_phase phase);
 double sim_phase_seconds(const struct sim *s, enum sim_phase phase);
 
 /* Value of probe i of the case at the current state (units: Pa, m). */

@@ -174,8 +174,12 @@ static enum poro_status init_water(struct sim *s)
 		memcpy(w->body, p->body, sizeof(int) * (size_t)p->n);
 	}
 	w->support = p->support;
-	for (idx_t q = 0; q < w->n; q++)
+	for (idx_t q = 0; q < w->n; q++) {
 		w->mass[q] = w->porosity0[q] * s->rho_w * w->volume0[q];   /* Eq. 37 */
+		/* the case's is physical (compression positive); the solver's tension positive */
+		const double p0 = s->spec->bodies[w->body[q]].initial_pore_pressure;
+		w->pressure[q] = p0 != 0.0 ? -p0 : 0.0;
+	}
 	return PORO_OK;
 }
 
@@ -315,10 +319,12 @@ double sim_clock(void)
 
 const char *sim_phase_name(enum sim_phase phase)
 {
-	static const char *const names[PHASE_COUNT] = {
-		"shape functions", "particle-to-grid", "predictors", "pressure assembly",
-		"pressure factor+solve", "correction", "grid-to-particle", "kinematics", "stress update"};
-	return phase < PHASE_COUNT ? names[phase] : "unknown";
+	return phase < PHASE_COUNT ? semi_implicit_scheme.phase_names[phase] : "unknown";
+}
+
+const char *sim_phase_name_of(const struct sim *s, enum sim_phase phase)
+{
+	return phase < PHASE_COUNT ? s->scheme->phase_names[phase] : NULL;
 }
 
 double sim_phase_seconds(const struct sim *s, enum sim_phase phase)

@@ -10,6 +10,7 @@
 
 #include "grid.h"
 #include "material.h"
+#include "permeability.h"
 #include "poro.h"
 #include "stable_dt.h"
 
@@ -20,10 +21,6 @@
 		if (st_ != PORO_OK)                     \
 			return st_;                     \
 	} while (0)
-
-/* Standard gravity in the drag term n^2 rho_w g / k (000 Eq. 15): hydraulic conductivity is
- * defined with it, so it stays 9.81 m/s^2 even when a case switches the body force off. */
-#define CONDUCTIVITY_GRAVITY 9.81
 
 struct sim {
 	const struct case_spec *spec;

@@ -62,7 +62,15 @@ double step_health_load_strain(const struct case_spec *c, int *body)
 void step_health_explain(struct sim *s)
 {
 	const struct stable_dt *e = &s->stable;
-	if (e->body >= 0) {
+	if (e->body >= 0 && e->scheme == SCHEME_EXPLICIT) {
+		char bound[STABLE_DT_DESCRIPTION_SIZE];
+		stable_dt_describe(e, s->spec, bound, sizeof bound);
+		const double ratio = s->dt / e->cfl;
+		poro_error_append(&s->err, "likely cause: %s: dt = %.6g s is %.3g of %s",
+				  ratio > STEP_HEALTH_EXPLICIT_DT_SUSPECT ? "a time step near or above the stability limit, "
+				  "take a smaller dt" : "not the time step, which is inside the stability limit",
+				  s->dt, ratio, bound);
+	} else if (e->body >= 0) {
 		const double ratio = s->dt / e->cfl;
 		poro_error_append(&s->err, "likely cause: %s: dt = %.6g s is %.3g times the soil skeleton's CFL step "
 				  "h / c_p = %.6g s (c_p = %.6g m/s in body '%s'); the Terzaghi column's measured limit "

@@ -20,6 +20,8 @@
 /* dt / (h / c_p) above which a failed step names the time step as its likely cause: the lowest
  * limit measured on the Terzaghi column is 0.87 h / c_p (drag in the correction, k = 1e-9 m/s). */
 #define STEP_HEALTH_DT_SUSPECT 0.8
+/* The explicit scheme's: dt over its critical step (stable_dt.h) above which the time step is named. */
+#define STEP_HEALTH_EXPLICIT_DT_SUSPECT 0.8
 
 /* The largest elastic strain the case's loads and gravity alone give a body: (the peak traction on
  * it + its buoyant weight over its height) / its constrained modulus; *body its index (-1: none).

@@ -50,7 +50,9 @@
  * case_spec.warnings (element_case.warnings), at most this many bytes with the NUL. */
 #define CASE_WARNINGS_SIZE 2048
 
-enum case_scheme { SCHEME_SEMI_IMPLICIT };
+/* The time-integration schemes (solver/schemes/): paper 000's semi-implicit fractional step and
+ * paper 002's explicit single-point v-w scheme with compressible pore fluid. */
+enum case_scheme { SCHEME_SEMI_IMPLICIT, SCHEME_EXPLICIT };
 enum case_phases { PHASES_DOUBLE_POINT, PHASES_SINGLE_POINT };
 enum case_shape { SHAPE_LINEAR, SHAPE_QUADRATIC_BSPLINE, SHAPE_CUBIC_BSPLINE, SHAPE_GIMP };
 /* The matrix of the pressure solve: the Laplacian of 000 Eq. 61, or the projection G^T M^-1 G
@@ -64,6 +66,15 @@ enum free_surface_condition { FREE_SURFACE_NODES, FREE_SURFACE_INTERPOLATED, FRE
 enum position_update { POSITION_UPDATE_GRID_VELOCITY, POSITION_UPDATE_MUSL_DISPLACEMENT };
 enum specific_volume { SPECIFIC_VOLUME_POINT, SPECIFIC_VOLUME_NODAL_AVERAGE };
 enum velocity_update { VELOCITY_UPDATE_FLIP, VELOCITY_UPDATE_APIC, VELOCITY_UPDATE_AFLIP };
+/* The explicit scheme's stabilisations (002 §3.2) and drag (spec-002 §5.1): the cell average of the
+ * volumetric strain rates of both phases (Eqs. 26-27) or none; the node-based multi-field pressure
+ * rate (Eqs. 28-34) with a constant or a linear basis, or each point's own rate; the drag integrated
+ * at the nodes implicitly over the step (stable at any permeability) or explicitly from the step's
+ * start velocities, as Eq. 22 prints it (stable below dt = 2 / lambda, stable_dt.h). */
+enum strain_rate_smoothing { STRAIN_RATE_SMOOTHING_CELL_AVERAGE, STRAIN_RATE_SMOOTHING_NONE };
+enum pressure_rate_projection { PRESSURE_RATE_MULTI_FIELD, PRESSURE_RATE_NONE };
+enum pressure_rate_basis { PRESSURE_RATE_BASIS_CONSTANT, PRESSURE_RATE_BASIS_LINEAR };
+enum drag_integration { DRAG_IMPLICIT, DRAG_EXPLICIT };
 /* Soil-phase stabilisation (000 §4.4.2, docs/numerics.md): none; F-bar with the node-wise averaged
  * volume change (Eqs. 79-80); modified F-bar (Eq. 81), which also scales Be^t to the patch-wise
  * averaged elastic Jacobian (Eqs. 82-83; patch 1.5 h for B-splines, the cell for linear); and the
@@ -107,9 +118,10 @@ enum probe_field { FIELD_PORE_PRESSURE, FIELD_STRESS_XX, FIELD_STRESS_YY, FIELD_
 		   FIELD_DISPLACEMENT_X, FIELD_DISPLACEMENT_Y };
 
 struct case_formulation {
-	enum case_scheme scheme;          /* "semi_implicit" */
+	enum case_scheme scheme;          /* "semi_implicit" or "explicit" (single point only) */
 	enum case_phases phases;          /* "double_point" (default) or "single_point" */
-	enum case_shape shape;            /* "linear", "quadratic_bspline" (default) or "cubic_bspline"; SHAPE_GIMP not offered yet (shape.h) */
+	enum case_shape shape;            /* "linear", "quadratic_bspline" (default), "cubic_bspline" or
+					     "gimp" (uGIMP; the explicit scheme only, shape.h) */
 	int pore_pressure_smoothing;      /* node-wise smoothing, 000 Eq. 77; default true */
 	enum velocity_update velocity_update; /* point velocities: "flip" (default, blended with PIC by
 						 flip_fraction), "apic" (affine PIC, transfer.h) or
@@ -129,6 +141,11 @@ struct case_formulation {
 	enum position_update position_update; /* soil points: "grid_velocity" (default) or "musl_displacement" */
 	enum specific_volume specific_volume; /* the J of Nor-Sand's v = J v0: "point" (default, 000 Eq. 95)
 						 or "nodal_average" (Eqs. 96-97) */
+	/* the explicit scheme's (002 §3.2, spec-002 §5.1) */
+	enum strain_rate_smoothing strain_rate_smoothing;   /* "cell_average" (default) or "none" */
+	enum pressure_rate_projection pressure_rate_projection; /* "multi_field" (default) or "none" */
+	enum pressure_rate_basis pressure_rate_basis;       /* "constant" (default) or "linear" */
+	enum drag_integration drag;                         /* "implicit" (default) or "explicit" */
 };
 
 struct case_grid {
@@ -192,6 +209,8 @@ struct case_body {
 	enum permeability_law permeability_law; /* "constant" (default), "kozeny_carman" (000 step 8g),
 						   "volume_ratio" (k = k0 V/V0) or "volume_ratio_squared"
 						   (k = k0 (V/V0)^2, Xie and Leo 2004) */
+	double initial_pore_pressure;     /* Pa, compression positive, default 0: the points' pore
+					     pressure at t = 0 (002 §4.1 starts at p0 = q with sigma' = 0) */
 };
 
 struct case_time_function {
@@ -201,6 +220,8 @@ struct case_time_function {
 	double amplitude;                 /* sinusoid: dimensionless; value = mean + amplitude sin(2 pi f t + phase) */
 	double mean;                      /* sinusoid: dimensionless, default 0 */
 	double phase;                     /* sinusoid: rad */
+	double start;                     /* sinusoid: s, default 0; value 0 before it and t counted
+					     from it (002 §4.3's load begins when gravity has ramped up) */
 };
 
 struct case_boundary {
@@ -244,7 +265,8 @@ struct case_spec {
 	struct case_body *bodies;
 	struct {
 		double density;           /* rho_w, kg/m^3 */
-		double bulk_modulus;      /* K_w, Pa (unused by the semi-implicit scheme; for the explicit one) */
+		double bulk_modulus;      /* K_w, Pa (the explicit scheme's compressible pore fluid, 002 Eq. 9;
+					     unused by the semi-implicit scheme) */
 		double cavitation_pressure; /* p_cav, the pressure at which the pore water boils, Pa, gauge
 					       (compression positive, as in case files), < 0; 0: no limit,
 					       the water takes any tension as in 000 (cavitation.c) */
@@ -266,7 +288,9 @@ struct case_spec {
 	int load_count;
 	struct case_load *loads;
 	struct {
-		double dt;                /* time step, s, > 0 */
+		double dt;                /* time step, s, > 0; "auto": the scheme's recommended step
+					     (stable_dt.h), written here by the loader */
+		int dt_auto;              /* 1 when the case asked for "auto" */
 		double end;               /* end time, s, > 0 */
 	} time;
 	struct {

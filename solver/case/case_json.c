@@ -348,6 +348,29 @@ int case_read_number(struct case_reader *r, const json_t *obj, const char *base,
 	return v && value_number(r, v, pointer, range, out);
 }
 
+int case_read_number_or_word(struct case_reader *r, const json_t *obj, const char *base, const char *key,
+			     enum case_need need, const struct case_range *range, const char *word, double *out,
+			     int *is_word)
+{
+	char pointer[CASE_POINTER_MAX], shown[CASE_QUOTE_SIZE];
+	const json_t *v = member(r, obj, base, key, need, pointer);
+	*is_word = 0;
+	if (!v)
+		return 0;
+	if (json_is_number(v))
+		return value_number(r, v, pointer, range, out);
+	if (json_is_string(v) && !strcmp(json_string_value(v), word)) {
+		*is_word = 1;
+		return 1;
+	}
+	if (json_is_string(v))
+		case_problem(r, pointer, "expected a number or \"%s\", got \"%s\"", word,
+			     case_quote(shown, json_string_value(v)));
+	else
+		case_problem(r, pointer, "expected a number or \"%s\", got %s", word, type_name(v));
+	return 0;
+}
+
 int case_read_int(struct case_reader *r, const json_t *obj, const char *base, const char *key,
 		  enum case_need need, int lo, int hi, int *out)
 {

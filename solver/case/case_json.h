@@ -109,6 +109,10 @@ int case_check_range(struct case_reader *r, const char *pointer, double x, const
 /* Member reads (see the conventions above). range may be NULL: any finite number. */
 int case_read_number(struct case_reader *r, const json_t *obj, const char *base, const char *key,
 		     enum case_need need, const struct case_range *range, double *out);
+/* A number in range, or the string word ("auto"): returns 1 with *out set, or with *is_word 1. */
+int case_read_number_or_word(struct case_reader *r, const json_t *obj, const char *base, const char *key,
+			     enum case_need need, const struct case_range *range, const char *word, double *out,
+			     int *is_word);
 int case_read_int(struct case_reader *r, const json_t *obj, const char *base, const char *key,
 		  enum case_need need, int lo, int hi, int *out);
 int case_read_bool(struct case_reader *r, const json_t *obj, const char *base, const char *key,

@@ -14,7 +14,7 @@
 	X(state, STATE_MAX, skel) X(plastic_strain, 1, skel)       \
 	X(dF, 4, skel) X(surface, 2, skel)                         \
 	X(shape, 4 * SHAPE_SUPPORT_MAX, !alias)                    \
-	X(C, 4, 0) /* allocated on request: particles_add_affine */
+	X(C, 4, 0) X(dF_zz, 1, 0) /* allocated on request: particles_add_affine, _out_of_plane */
 
 static enum poro_status allocate(struct particles *p, idx_t n, int skel, int alias, struct poro_error *err)
 {
@@ -74,6 +74,14 @@ enum poro_status particles_add_affine(struct particles *p, struct poro_error *er
 	return PORO_OK;
 }
 
+enum poro_status particles_add_out_of_plane(struct particles *p, struct poro_error *err)
+{
+	if (!p->dF_zz && !(p->dF_zz = calloc(p->n > 0 ? (size_t)p->n : 1, sizeof(double))))
+		return poro_error_set(err, PORO_ENOMEM, "cannot allocate the out-of-plane stretches of %ld points",
+				      (long)p->n);
+	return PORO_OK;
+}
+
 void particles_remove(struct particles *p, idx_t q)
 {
 	idx_t last = p->n - 1;
@@ -99,6 +107,6 @@ void particles_release(struct particles *p)
 	}
 	free(p->v); free(p->C); free(p->mass); free(p->pressure);
 	free(p->stress); free(p->F); free(p->Be); free(p->state); free(p->plastic_strain);
-	free(p->dF); free(p->surface); free(p->surface_load);
+	free(p->dF); free(p->dF_zz); free(p->surface); free(p->surface_load);
 	memset(p, 0, sizeof *p);
 }

@@ -52,6 +52,8 @@ struct particles {
 	double *state;              /* [STATE_MAX n] constitutive internal variables */
 	double *plastic_strain;     /* [n] accumulated plastic strain (0 for elastic models) */
 	double *dF;                 /* [4n] scratch: deformation gradient increment of this step */
+	double *dF_zz;              /* [n] its out-of-plane stretch, for a scheme whose smoothed volumetric
+				       rate has a zz part (002 Eq. 27); NULL: plane strain, dF_zz = 1 */
 	double *surface;            /* [2n] loaded-face length vector N dA in the reference configuration,
 				       m per m (zero for interior points); see loads.c */
 	int *surface_load;          /* [n] index of the case load acting on the point, -1 if none */
@@ -89,6 +91,9 @@ enum poro_status particles_init_alias(struct particles *w, const struct particle
 
 /* Gives p an affine velocity array C, zeroed (APIC, transfer.h). Returns PORO_ENOMEM on failure. */
 enum poro_status particles_add_affine(struct particles *p, struct poro_error *err);
+
+/* Gives p an out-of-plane stretch array dF_zz, zeroed. Returns PORO_ENOMEM on failure. */
+enum poro_status particles_add_out_of_plane(struct particles *p, struct poro_error *err);
 
 /* Removes point q by moving the last point into its place (order is not kept). Not for aliased
  * sets or sets with skeleton arrays. */

@@ -1,5 +1,6 @@
 /*
- * oscillation.c - oscillation index of the mean effective stress (definition in oscillation.h).
+ * oscillation.c - oscillation index of the mean effective stress or of any point field (definition in
+ * oscillation.h).
  *
  * Points are placed on a dense table of lattice sites by their reference positions (site
  * floor((x0 - origin) / spacing) per direction), one point per site, and summed into blocks of
@@ -24,8 +25,8 @@ static double overshoot(double v, double a, double b)
 	return v > hi ? v - hi : v < lo ? lo - v : 0.0;
 }
 
-enum poro_status oscillation_index_blocks(const struct case_grid *g, const struct particles *p, double spacing,
-					  int block, double *index, struct poro_error *err)
+enum poro_status oscillation_index_of(const struct case_grid *g, const struct particles *p, double spacing,
+				      int block, const double *value, double *index, struct poro_error *err)
 {
 	*index = 0.0;
 	if (!(spacing > 0.0) || block < 1)
@@ -51,7 +52,7 @@ enum poro_status oscillation_index_blocks(const struct case_grid *g, const struc
 			continue;
 		taken[u + v * sites[0]] = 1;
 		long k = u / block + (v / block) * blocks[0];
-		sum[k] += mean_effective_stress(p, i);
+		sum[k] += value ? value[i] : mean_effective_stress(p, i);
 		count[k]++;
 	}
 	for (long k = 0; k < block_count; k++)
@@ -80,9 +81,15 @@ enum poro_status oscillation_index_blocks(const struct case_grid *g, const struc
 	if (terms == 0 || !(sum_p2 > 0.0))
 		return poro_error_set(err, PORO_EINVAL, "oscillation index: %s",
 				      terms == 0 ? "no soil point has two lattice neighbours" :
-						   "the mean effective stress is zero");
+				      value ? "the field is zero" : "the mean effective stress is zero");
 	*index = sqrt(sum_e2 / (double)terms) / sqrt(sum_p2 / (double)filled);
 	return PORO_OK;
+}
+
+enum poro_status oscillation_index_blocks(const struct case_grid *g, const struct particles *p, double spacing,
+					  int block, double *index, struct poro_error *err)
+{
+	return oscillation_index_of(g, p, spacing, block, NULL, index, err);
 }
 
 enum poro_status oscillation_index(const struct case_grid *g, const struct particles *p, double spacing,

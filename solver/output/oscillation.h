@@ -1,5 +1,6 @@
 /*
- * oscillation.h - the oscillation index of the soil's mean effective stress: a measure of the
+ * oscillation.h - the oscillation index of the soil's mean effective stress (or of any point field,
+ * such as the pore pressure): a measure of the
  * point-to-point stress noise that volumetric locking leaves (000 §4.4.2, App. A, Fig. 12), for
  * tests and reports.
  *
@@ -39,5 +40,11 @@ enum poro_status oscillation_index(const struct case_grid *g, const struct parti
 /* The same over blocks of block x block lattice sites (see above); PORO_EINVAL also for block < 1. */
 enum poro_status oscillation_index_blocks(const struct case_grid *g, const struct particles *p, double spacing,
 					  int block, double *index, struct poro_error *err);
+
+/* The same index of any per-point scalar field of p (value[n]; NULL: the mean effective stress),
+ * e.g. the pore pressure, whose checkerboard 002 §4.2 shows without its stabilisations (Fig. 10b).
+ * "Zero" then refers to that field. */
+enum poro_status oscillation_index_of(const struct case_grid *g, const struct particles *p, double spacing,
+				      int block, const double *value, double *index, struct poro_error *err);
 
 #endif

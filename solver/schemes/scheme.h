@@ -19,8 +19,19 @@
 
 #include "sim_internal.h"
 
+/* Runs one phase of a step and adds its wall time to the phase's account (poro.h, enum sim_phase). */
+#define PHASE(which, call)                                              \
+	do {                                                            \
+		double t0_ = sim_clock();                               \
+		call;                                                   \
+		s->phase_seconds[which] += sim_clock() - t0_;           \
+	} while (0)
+
 struct scheme {
 	const char *name;                              /* formulation.scheme */
+	/* What each of the step's phase slots (poro.h, enum sim_phase) times in this scheme; NULL
+	 * for a slot the scheme does not use. */
+	const char *phase_names[PHASE_COUNT];
 	/* Builds the scheme's state once the grid, points, materials, boundaries and loads exist. */
 	enum poro_status (*create)(struct sim *s);
 	void (*destroy)(struct sim *s);                /* frees s->scheme_state; NULL state is fine */
@@ -31,5 +42,7 @@ struct scheme {
 
 /* The scheme a case asks for. */
 const struct scheme *scheme_of(enum case_scheme kind);
+
+extern const struct scheme semi_implicit_scheme, explicit_scheme;
 
 #endif

@@ -11,6 +11,7 @@
  * the root, so a relative __FILE__ means the tests run from there too).
  */
 #include "case.h"
+#include "case_json.h"   /* case_read_text */
 #include "element.h"
 #include "stable_dt.h"
 
@@ -789,6 +790,74 @@ static void test_stable_dt(const char *root)
 	case_destroy(&c);
 }
 
+/* The explicit scheme's keys (case_formulation.c): each refused with its pointer, and a valid
+ * explicit case read with every key (002 §4.1's column, cases/terzaghi_002.json). */
+static void test_explicit_scheme(const char *root)
+{
+	char path[512];
+	snprintf(path, sizeof path, "%stests/cases/terzaghi_002.json", root);
+	char *base = NULL;
+	struct poro_error err = {0};
+	if (case_read_text(path, &base, &err)) {
+		CHECK(0, "explicit case readable", "%s", err.message);
+		return;
+	}
+	const struct {
+		const char *name, *pointer, *value, *needle;
+	} bad[] = {
+		{"explicit scheme is single point", "/formulation/phases", "\"double_point\"",
+		 "/formulation/phases: the \"explicit\" scheme is single point"},
+		{"semi-implicit key under explicit", "/formulation/drag_in_correction", "true",
+		 "/formulation/drag_in_correction: applies to the \"semi_implicit\" scheme only, not to \"explicit\""},
+		{"unknown smoothing", "/formulation/strain_rate_smoothing", "\"cell\"",
+		 "/formulation/strain_rate_smoothing: must be one of 'cell_average', 'none'"},
+		{"unknown drag", "/formulation/drag", "\"lumped\"", "/formulation/drag: must be one of"},
+		{"basis without projection", "/formulation/pressure_rate_basis", "\"linear\"", NULL},
+		{"dt neither number nor auto", "/time/dt", "\"fast\"",
+		 "/time/dt: expected a number or \"auto\", got \"fast\""},
+		{"dt above the critical step", "/time/dt", "1e-4", "h / c_fast"},
+		{"initial pore pressure not a number", "/bodies/0/initial_pore_pressure", "\"1e4\"",
+		 "/bodies/0/initial_pore_pressure: expected a number, got string"},
+		{"sinusoid start before 0", "/loads/0/time_function",
+		 "{\"kind\": \"sinusoid\", \"frequency\": 2.5, \"amplitude\": 1, \"start\": -0.1}",
+		 "/loads/0/time_function/start: must be >= 0"},
+		{"drained face with held water", "/boundaries/bottom", "{\"soil\": \"fixed\", \"water\": \"slip\", "
+		 "\"drainage\": \"drained\"}", "/boundaries/bottom/drainage: \"drained\" needs \"water\": \"free\""},
+		{"plate under explicit", "/boundaries/top", "{\"soil\": \"plate\", \"water\": \"plate\", "
+		 "\"plate\": {\"force\": 1000}}", "/boundaries/top/soil: \"plate\" applies to the \"semi_implicit\" scheme only"},
+		{"cavitation under explicit", "/fluid/cavitation_pressure", "-1e5",
+		 "/fluid/cavitation_pressure: applies to the \"semi_implicit\" scheme only"},
+	};
+	for (size_t i = 0; i < sizeof bad / sizeof *bad; i++) {
+		struct edit e[2] = {{bad[i].pointer, bad[i].value}, {"/formulation/pressure_rate_projection", "\"none\""}};
+		const char *needles[] = {bad[i].needle ? bad[i].needle
+						       : "/formulation/pressure_rate_basis: needs /formulation/pressure_rate_projection",
+					 NULL};
+		expect_invalid_edits(bad[i].name, base, e, bad[i].needle ? 1 : 2, needles);
+	}
+	/* an explicit key under the semi-implicit scheme */
+	const struct edit semi[] = {{"/formulation", "{\"scheme\": \"semi_implicit\", \"phases\": \"single_point\", "
+				     "\"drag\": \"explicit\"}"}};
+	const char *semi_needle[] = {"/formulation/drag: applies to the \"explicit\" scheme only, not to \"semi_implicit\"",
+				     NULL};
+	expect_invalid_edits("explicit key under semi-implicit", base, semi, 1, semi_needle);
+	const struct edit all[] = {{"/formulation", "{\"scheme\": \"explicit\", \"phases\": \"single_point\", "
+				    "\"shape\": \"gimp\", \"strain_rate_smoothing\": \"none\", \"pressure_rate_projection\": "
+				    "\"multi_field\", \"pressure_rate_basis\": \"linear\", \"drag\": \"explicit\", "
+				    "\"flip_fraction\": 0.95}"}, {"/time/dt", "\"auto\""}};
+	char *text = edited(base, all, 2);
+	struct case_spec *c = load_valid("explicit case with every key", text);
+	CHECK(c && c->formulation.scheme == SCHEME_EXPLICIT && c->formulation.shape == SHAPE_GIMP &&
+	      c->formulation.strain_rate_smoothing == STRAIN_RATE_SMOOTHING_NONE &&
+	      c->formulation.pressure_rate_projection == PRESSURE_RATE_MULTI_FIELD &&
+	      c->formulation.pressure_rate_basis == PRESSURE_RATE_BASIS_LINEAR && c->formulation.drag == DRAG_EXPLICIT &&
+	      c->time.dt_auto && c->time.dt > 0 && c->bodies[0].initial_pore_pressure == 1e4,
+	      "explicit keys read", "case %p", (void *)c);
+	case_destroy(&c);
+	free(text);
+	free(base);
+}
+
 int main(void)
 {
 	char root[256];
@@ -809,5 +878,6 @@ int main(void)
 	test_shipped_cases(root);
 	test_documented_example(root);
 	test_stable_dt(root);
+	test_explicit_scheme(root);
 	HARNESS_EXIT();
 }

@@ -288,14 +288,6 @@ static enum poro_status update_soil_kinematics(struct sim *s)
 	return deformation_apply(s);
 }
 
-/* Runs one phase and adds its wall time to the phase's account. */
-#define PHASE(which, call)                                              \
-	do {                                                            \
-		double t0_ = sim_clock();                               \
-		call;                                                   \
-		s->phase_seconds[which] += sim_clock() - t0_;           \
-	} while (0)
-
 enum poro_status semi_implicit_step(struct sim *s)
 {
 	enum poro_status st = PORO_OK;
@@ -330,6 +322,8 @@ enum poro_status semi_implicit_step(struct sim *s)
 
 const struct scheme semi_implicit_scheme = {
 	.name = "semi_implicit",
+	.phase_names = { "shape functions", "particle-to-grid", "predictors", "pressure assembly",
+			 "pressure factor+solve", "correction", "grid-to-particle", "kinematics", "stress update" },
 	.create = create,
 	.destroy = destroy,
 	.step = semi_implicit_step,

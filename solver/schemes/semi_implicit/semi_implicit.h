@@ -75,7 +75,6 @@ static inline struct semi_implicit *semi_implicit_of(const struct sim *s)
 }
 
 /* semi_implicit.c: the scheme's entry in scheme.h, and its step (000 §4.5). */
-extern const struct scheme semi_implicit_scheme;
 enum poro_status semi_implicit_step(struct sim *s);
 
 /* pressure.c: the Poisson solve (000 §4.5 step 5). */
