@@ -189,9 +189,10 @@ static void draw_line(struct watch *w, long long id, const json_t *job)
 	const json_t *p = json_object_get(job, "progress");
 	double fraction = json_get_real(p, "fraction", 0);
 	int tenth = (int)(fraction * 10);
+	/* every poll with progress counts for the rate, printed or not */
+	double left = json_is_object(p) ? time_left(w, json_get_int(job, "attempt", 0), fraction) : -1;
 	if (!strcmp(state, w->state) && !strcmp(reason, w->reason) && tenth <= w->tenth)
 		return;
-	double left = json_is_object(p) ? time_left(w, json_get_int(job, "attempt", 0), fraction) : -1;
 	if (!strcmp(state, "queued")) {
 		fprintf(stderr, "job %lld queued%s%s\n", id, *reason ? ": " : "",
 			json_get_str(waiting, "message", ""));
