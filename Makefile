@@ -125,7 +125,11 @@ $(BUILD)/poro-server: $(SERVER_OBJ) $(COMMON_OBJ) $(LIBPORO)
 $(BUILD)/poro-worker: $(WORKER_OBJ) $(CLIENT_OBJ) $(COMMON_OBJ)
 	$(CC) $(LDFLAGS) $^ -lcurl $(SVC_LIBS) -o $@
 
-$(BUILD)/poro: $(BUILD)/cli/poro.o $(CLIENT_OBJ) $(COMMON_OBJ)
+# poro: cli/poro.c and its commands in cli/poro/
+PORO_CLI_OBJ = $(patsubst %.c,$(BUILD)/%.o,$(wildcard cli/poro/*.c))
+$(BUILD)/cli/poro.o $(PORO_CLI_OBJ): $(wildcard cli/poro/*.h)
+
+$(BUILD)/poro: $(BUILD)/cli/poro.o $(PORO_CLI_OBJ) $(CLIENT_OBJ) $(COMMON_OBJ)
 	$(CC) $(LDFLAGS) $^ -lcurl $(SVC_LIBS) -lm -o $@
 
 $(BUILD)/poro-load: $(BUILD)/bench/poro_load.o $(CLIENT_OBJ) $(COMMON_OBJ)

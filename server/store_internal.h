@@ -84,10 +84,12 @@ json_t *col_json_time(sqlite3_stmt *st, int i);
 /* SELECT list of a job row for job_from_row(), joined as "FROM jobs j JOIN users u ON u.id = j.user_id". */
 #define JOB_COLUMNS "j.id, u.name, j.name, j.state, j.priority, j.threads, j.wall_time_seconds, j.attempt, " \
 	"j.created_at, j.started_at, j.finished_at, j.case_sha256, j.solver_version, j.worker_host, " \
-	"j.progress, j.message, j.cancel_requested, j.user_id "
-json_t *job_from_row(sqlite3_stmt *st);
+	"j.progress, j.message, j.cancel_requested, j.user_id, j.not_before, u.running, u.max_running "
+/* The job of a row of JOB_COLUMNS as JSON; s gives what "waiting" needs besides the row (the
+ * default cap on running jobs, whether a worker is live). */
+json_t *job_from_row(struct store *s, sqlite3_stmt *st);
 /* The job as JSON (full: with files and events), read through c; NULL with err set if missing. */
-json_t *job_load(struct conn *c, long long id, int full, struct api_error *err);
+json_t *job_load(struct store *s, struct conn *c, long long id, int full, struct api_error *err);
 /* Moves a job from one state to another: updates the job, the owner's counters and writes the
  * event row (actor, attempt, detail). The caller has checked that the job is in `from`. */
 enum api_code job_transition(struct conn *c, long long id, enum job_state from, enum job_state to, int attempt,

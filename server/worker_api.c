@@ -73,6 +73,8 @@ void worker_claim(struct request *r)
 	struct job_claim in = { .who = &r->who, .worker = worker, .host = host ? host : worker };
 	long long deadline = now_ms() + 1000 * wait;
 	metrics_worker_seen(srv->metrics, r->who.name);
+	server_worker_seen(srv);
+	atomic_fetch_add(&srv->claims_waiting, 1);
 	for (;;) {
 		pthread_mutex_lock(&srv->wake_lock);
 		unsigned long long seq = srv->claim_seq;
@@ -98,6 +100,8 @@ void worker_claim(struct request *r)
 		}
 		wait_for_work(srv, seq, deadline);
 	}
+	atomic_fetch_sub(&srv->claims_waiting, 1);
+	server_worker_seen(srv);
 	json_decref(body);
 }
 
@@ -126,6 +130,7 @@ void worker_heartbeat(struct request *r)
 		goto done;
 	}
 	metrics_worker_seen(r->srv->metrics, r->who.name);
+	server_worker_seen(r->srv);
 	char at[32];
 	format_time(expires, at);
 	reply_json(r, 200, json_pack("{s:b, s:s}", "cancel", cancel, "lease_expires_at", at));

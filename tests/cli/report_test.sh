@@ -151,7 +151,7 @@ refused 2 rectangle_body_without_ground_exits_2 "body 'column' is a rectangle" "
 	--out "$tmp/refused.csv"
 refused 2 malformed_line_exits_2_naming_it "malformed line '0,1,2'" "$run/result.h5" "${good[@]}" \
 	--line 0,1,2 --line-out "$tmp/l.csv"
-refused 2 unknown_option_exits_2_naming_it "unknown option '--frobnicate'" "$run/result.h5" "${good[@]}" \
+refused 2 unknown_option_exits_2_naming_it "unrecognized option '--frobnicate'" "$run/result.h5" "${good[@]}" \
 	--frobnicate 1
 refused 2 ground_not_a_number_exits_2 "--ground: 'five' is not a number" "$run/result.h5" --ground five --crest 0.05
 refused 2 at_outside_run_exits_2 "time 5 s is outside the run" "$run/result.h5" "${good[@]}" \
