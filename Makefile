@@ -45,7 +45,7 @@ COMMON_OBJ = $(patsubst %.c,$(BUILD)/%.o,$(wildcard common/*.c))
 CLIENT_OBJ = $(patsubst %.c,$(BUILD)/%.o,$(wildcard client/*.c))
 SERVER_OBJ = $(patsubst %.c,$(BUILD)/%.o,$(wildcard server/*.c))
 WORKER_OBJ = $(patsubst %.c,$(BUILD)/%.o,$(wildcard worker/*.c))
-SVC_LIBS   = -ljansson -lcrypto -lpthread
+SVC_LIBS   = -ljansson -lcrypto -lpthread -lm
 # poro-server links libporo.a for case validation only, and never HDF5: it does not read result files
 # (probes come from `poro-solve probes`, run by the worker), so a damaged file cannot crash it.
 # tests/service/integrity_test.sh checks with ldd that no libhdf5 is linked.
