@@ -102,7 +102,7 @@ $(POROSOLVE): $(BUILD)/cli/poro_solve.o $(LIBPORO)
 $(BUILD)/terzaghi-error: $(BUILD)/tools/terzaghi_error.o $(LIBPORO)
 	$(CC) $(LDFLAGS) $^ $(LDLIBS) -o $@
 
-$(BUILD)/tools/terzaghi_error.o: tests/verify/analytic.h
+$(BUILD)/tools/terzaghi_error.o: solver/verify/analytic.h
 
 # poro-plot is a Python program (matplotlib, h5py): "built" by copying it beside poro-solve, which
 # it calls for the run-out picture.

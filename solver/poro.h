@@ -97,4 +97,22 @@ enum poro_status sim_run(struct sim *s, const char *out_dir, const char *solver_
 /* Wall-clock interval between checkpoints in sim_run, s; 0 (the default) = by simulated time only. */
 void sim_set_checkpoint_wall(struct sim *s, double seconds);
 
+/* What the steps sim_run took in this process cost (a resumed run counts from its checkpoint):
+ * wall and processor seconds (CLOCK_PROCESS_CPUTIME_ID: every thread), the steps, and the points
+ * stepped (soil plus water points), for the timing figures (figures.h). Frames, probes and
+ * checkpoints between the steps are not counted. */
+struct sim_timing {
+	double wall_seconds, cpu_seconds;
+	long steps;
+	long points;
+};
+void sim_get_timing(const struct sim *s, struct sim_timing *t);
+
+/* A test knob, never set by a case (docs/benchmarks.md, "Test knobs"): with factor > 1 sim_run
+ * repeats, before each step, the step's first phase (the shape functions at the points' present
+ * positions, which the step then computes again from the same positions) until that costs
+ * (factor - 1) times the previous step's processor time, so each step costs about factor times
+ * as much and every result stays bit-identical. 1 (the default) is off. */
+void sim_set_slowdown(struct sim *s, double factor);
+
 #endif

@@ -59,6 +59,8 @@ struct sim {
 	int *probe_point;             /* [probe_count] tracked point of point probes, -1 otherwise */
 	int resumed;                  /* 1: the state was loaded from a checkpoint (checkpoint.c) */
 	double checkpoint_wall;       /* s of wall time between checkpoints in sim_run; 0 = none */
+	struct sim_timing timing;     /* the steps sim_run took in this process (run.c) */
+	double slowdown;              /* test knob of sim_set_slowdown (run.c); 1 = off */
 	struct poro_error err;
 };
 
