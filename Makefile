@@ -129,7 +129,9 @@ $(BUILD)/poro-worker: $(WORKER_OBJ) $(CLIENT_OBJ) $(COMMON_OBJ)
 PORO_CLI_OBJ = $(patsubst %.c,$(BUILD)/%.o,$(wildcard cli/poro/*.c))
 $(BUILD)/cli/poro.o $(PORO_CLI_OBJ): $(wildcard cli/poro/*.h)
 
-$(BUILD)/poro: $(BUILD)/cli/poro.o $(PORO_CLI_OBJ) $(CLIENT_OBJ) $(COMMON_OBJ)
+# poro nightly checks a suite's figures against the solver's own table of them (figures.o, which
+# needs nothing else of the solver)
+$(BUILD)/poro: $(BUILD)/cli/poro.o $(PORO_CLI_OBJ) $(CLIENT_OBJ) $(COMMON_OBJ) $(BUILD)/solver/verify/figures.o
 	$(CC) $(LDFLAGS) $^ -lcurl $(SVC_LIBS) -lm -o $@
 
 $(BUILD)/poro-load: $(BUILD)/bench/poro_load.o $(CLIENT_OBJ) $(COMMON_OBJ)

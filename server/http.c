@@ -25,6 +25,7 @@
  * transactions, so a failed one leaves nothing half done.
  */
 #include "api.h"
+#include "bench.h"
 #include "front_door.h"
 #include "http.h"
 #include "metrics.h"
@@ -85,6 +86,12 @@ static const struct route ROUTES[] = {
 	{ "POST", "/v1/tokens", ROLE_ADMIN, BODY_SMALL, admin_tokens_create, 0, 0, 0, 0 },
 	{ "GET", "/v1/tokens", USER_ROLES, BODY_SMALL, admin_tokens_list, 0, 0, 0, 0 },
 	{ "DELETE", "/v1/tokens/{id}", USER_ROLES, BODY_SMALL, admin_tokens_revoke, 0, 0, 0, 0 },
+	/* benchmark runs (bench.h): a plan names up to 500 cases, so it may be larger than a small body */
+	{ "POST", "/v1/benchmarks", USER_ROLES, BODY_CASE, bench_create, 0, 0, 0, 0 },
+	{ "GET", "/v1/benchmarks", USER_ROLES, BODY_SMALL, bench_list, 0, 0, 0, 0 },
+	{ "GET", "/v1/benchmarks/series", USER_ROLES, BODY_SMALL, bench_series, 0, 0, 0, 0 },
+	{ "GET", "/v1/benchmarks/{id}", USER_ROLES, BODY_SMALL, bench_show, 0, 0, 0, 0 },
+	{ "POST", "/v1/benchmarks/{id}/finish", USER_ROLES, BODY_SMALL, bench_finish, 0, 0, 0, 0 },
 };
 #define ROUTE_COUNT (sizeof ROUTES / sizeof ROUTES[0])
 

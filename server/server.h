@@ -73,6 +73,7 @@ struct server_config {
 	X(API_LOG_GAP,              409, "log_gap")                          \
 	X(API_ALREADY_EXISTS,       409, "already_exists")                   \
 	X(API_ARTIFACT_MISSING,     409, "artifact_missing")                 \
+	X(API_NOT_FINISHED,         409, "not_finished")                     \
 	X(API_TOO_LARGE,            413, "body_too_large")                   \
 	X(API_BODY_TOO_COMPLEX,     413, "body_too_complex")                 \
 	X(API_URI_TOO_LONG,         414, "uri_too_long")                     \
