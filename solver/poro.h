@@ -103,6 +103,7 @@ void sim_set_checkpoint_wall(struct sim *s, double seconds);
  * checkpoints between the steps are not counted. */
 struct sim_timing {
 	double wall_seconds, cpu_seconds;
+	double median_step_cpu;          /* s: the median step's processor time (step_timing.h) */
 	long steps;
 	long points;
 };

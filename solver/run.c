@@ -58,6 +58,7 @@ void sim_get_timing(const struct sim *s, struct sim_timing *t)
 {
 	*t = s->timing;
 	t->points = (long)s->soil.n + (s->double_point ? (long)s->water.n : 0);
+	t->median_step_cpu = step_histogram_median(&s->step_cpu);
 }
 
 /* The slowdown knob: step 1 (the shape functions at the present positions, which the step about
@@ -81,6 +82,8 @@ static enum poro_status timed_step(struct sim *s, double *last_cpu)
 		st = sim_step(s);
 	double c2 = cpu_now();
 	*last_cpu = c2 - c1;
+	if (!st)
+		step_histogram_add(&s->step_cpu, c2 - c0);
 	s->timing.cpu_seconds += c2 - c0;
 	s->timing.wall_seconds += wall_now() - w0;
 	s->timing.steps += !st;
@@ -183,8 +186,10 @@ enum poro_status sim_run(struct sim *s, const char *out_dir, const char *solver_
 	const long step0 = s->step;
 	int appended = 0;
 	double *values = calloc((size_t)s->spec->probe_count + 1, sizeof(double));
-	if (!values)
-		return poro_error_set(&s->err, PORO_ENOMEM, "cannot allocate probe values");
+	if (!values || (!s->step_cpu.count && step_histogram_init(&s->step_cpu))) {
+		free(values);
+		return poro_error_set(&s->err, PORO_ENOMEM, "cannot allocate probe values and step times");
+	}
 	enum poro_status st = open_output(s, out_dir, solver_version, &o, &appended);
 	const double interval = s->spec->output.frame_interval;
 	const double checkpoint_interval = s->spec->checkpoint.interval;

@@ -36,6 +36,7 @@ static const char *const MEANINGS[FIGURE_COUNT] = {
 	[FIGURE_CPU_SECONDS] = "processor time of the steps this process took, all threads",
 	[FIGURE_US_PER_POINT_STEP] = "wall microseconds per material-point step",
 	[FIGURE_CPU_US_PER_POINT_STEP] = "processor microseconds per material-point step",
+	[FIGURE_MEDIAN_STEP_CPU_US] = "the median step's processor microseconds per material point",
 	[FIGURE_STEPS] = "steps taken",
 	[FIGURE_MAX_DISPLACEMENT] = "largest displacement of a soil point at the end",
 	[FIGURE_TERZAGHI_RMS] = "RMS pore-pressure error against Terzaghi's closed form, over q, at the end",

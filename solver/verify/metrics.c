@@ -83,6 +83,7 @@ void metrics_of_run(struct metrics *m, const struct sim *s, const struct case_sp
 	metrics_set(m, FIGURE_CPU_SECONDS, t.cpu_seconds);
 	metrics_set(m, FIGURE_US_PER_POINT_STEP, point_steps > 0 ? 1e6 * t.wall_seconds / point_steps : NAN);
 	metrics_set(m, FIGURE_CPU_US_PER_POINT_STEP, point_steps > 0 ? 1e6 * t.cpu_seconds / point_steps : NAN);
+	metrics_set(m, FIGURE_MEDIAN_STEP_CPU_US, t.points > 0 ? 1e6 * t.median_step_cpu / (double)t.points : NAN);
 	metrics_set(m, FIGURE_STEPS, (double)sim_steps_taken(s));
 	if (error)
 		return;   /* the state a failure left says nothing about accuracy */
