@@ -20,6 +20,11 @@ packages=(
   python3-paraview      # ParaView's own XDMF readers, which tests/cli/paraview_test.sh opens
                         # result.xdmf with (no display needed: readers only)
   curl procps           # the service tests speak HTTP with curl and find processes with pgrep
+  python3-jsonschema    # the metrics and suite documents checked against schemas/ (tests)
+  python3-junitparser   # a JUnit XML reader: the nightly's JUnit report read by a real consumer
+  python3-pil           # the nightly test looks for the plots in chromium's screenshot
+  chromium              # headless: the nightly's HTML report opened and drawn (tests)
+  util-linux            # taskset: the nightly test's second machine fingerprint (one processor)
 )
 
 # The OpenAPI linter of make test (tools/openapi-lint, pinned in its package-lock.json) runs on

@@ -6,6 +6,7 @@
  *   poro nightly compare A B [--json]
  *   poro nightly ls [--suite S] [--limit N] [--json]
  *   poro nightly report ID [--junit FILE] [--html FILE]
+ *   poro nightly check SUITE.json [--out DIR] [--only CASE]...
  *
  * run reads and checks the suite (suite.c) before anything is sent, submits every case's repeats
  * as jobs of one batch (each carries the run's label; a case with a figure judged against history
@@ -14,6 +15,10 @@
  * the server to finish the run once every job has ended, and prints the verdicts. Exit 0 when the
  * run passed, 9 (PORO_EXIT_REGRESSED) when a figure regressed, failed or did not run.
  *
+ * check reads and checks a suite without a server and prints what run would submit; with --out it
+ * writes each case as submitted (patched, with the metrics it asks for) into DIR/NAME.json, which
+ * `poro-solve validate` checks as the server would.
+ *
  * The commit is `git describe --always --dirty --tags` of the suite file's checkout (--commit
  * overrides it; "unknown" outside a checkout): what the nightly ran, for the reports' x-axis.
  */
@@ -21,10 +26,12 @@
 #include "cli.h"
 #include "nightly.h"
 
+#include <errno.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include "bench_names.h"
@@ -38,7 +45,7 @@
 #define BAR_WIDTH 30
 
 struct nightly_options {
-	const char *label, *commit, *junit, *html, *suite;
+	const char *label, *commit, *junit, *html, *suite, *out;
 	const char *only[ONLY_MAX];
 	int only_count, json;
 	long long limit;
@@ -247,6 +254,39 @@ static int nightly_run(const struct nightly_options *o, const char *path)
 	int verdict = exit_of_run(r.json);
 	http_response_release(&r);
 	return rc ? rc : reports ? reports : verdict;
+}
+
+/* check: the plan of a suite, and with out the cases as they would be submitted. */
+static int nightly_check(const struct nightly_options *o, const char *path)
+{
+	struct suite s;
+	int rc = suite_load(path, o->only, o->only_count, &s);
+	if (rc)
+		return rc;
+	if (o->out && mkdir(o->out, 0777) && errno != EEXIST) {
+		fprintf(stderr, "poro: cannot create '%s': %s\n", o->out, strerror(errno));
+		suite_release(&s);
+		return PORO_EXIT_ERROR;
+	}
+	printf("suite %s: %d cases\n", s.name, s.count);
+	for (int i = 0; i < s.count && !rc; i++) {
+		const struct suite_case *c = &s.cases[i];
+		printf("%-24s %-40s %3d repeat%s%s:", c->name, c->path, c->repeats, c->repeats == 1 ? " " : "s",
+		       c->exclusive ? ", exclusive" : "");
+		size_t k;
+		const json_t *f;
+		json_array_foreach(c->figures, k, f)
+			printf(" %s (%s)", json_get_str(f, "kind", "?"), json_get_str(f, "check", "?"));
+		printf("\n");
+		char file[8400];
+		snprintf(file, sizeof file, "%s/%s.json", o->out ? o->out : ".", c->name);
+		if (o->out && json_dump_file(c->spec, file, JSON_INDENT(1)) != 0) {
+			fprintf(stderr, "poro: cannot write '%s'\n", file);
+			rc = PORO_EXIT_ERROR;
+		}
+	}
+	suite_release(&s);
+	return rc;
 }
 
 /* ---- show, compare, ls ---- */
@@ -472,9 +512,13 @@ static int nightly_report(const struct nightly_options *o, long long id)
 /* The options each command takes beyond --json and --help; a misplaced one is refused. */
 static int check_options(const struct subcommand *self, const char *what, const struct nightly_options *o)
 {
-	int run = !strcmp(what, "run"), report = !strcmp(what, "report");
-	if (!run && (o->label || o->commit || o->only_count))
-		return cli_usage_error(self, "--label, --commit and --only are options of 'nightly run'");
+	int run = !strcmp(what, "run"), report = !strcmp(what, "report"), plan = !strcmp(what, "check");
+	if (!run && (o->label || o->commit))
+		return cli_usage_error(self, "--label and --commit are options of 'nightly run'");
+	if (!run && !plan && o->only_count)
+		return cli_usage_error(self, "--only is an option of 'nightly run' and 'nightly check'");
+	if (!plan && o->out)
+		return cli_usage_error(self, "--out is an option of 'nightly check'");
 	if (!run && !report && (o->junit || o->html))
 		return cli_usage_error(self, "--junit and --html are options of 'nightly run' and 'nightly report'");
 	if (strcmp(what, "ls") && (o->suite || o->limit != LS_LIMIT_DEFAULT))
@@ -491,15 +535,15 @@ static int check_options(const struct subcommand *self, const char *what, const 
 /* The command word and its arguments, once the options are parsed. */
 static int nightly_dispatch(const struct subcommand *self, int argc, char **argv, const struct nightly_options *o)
 {
-	static const char *const words[] = { "run", "show", "compare", "ls", "report", NULL };
+	static const char *const words[] = { "run", "show", "compare", "ls", "report", "check", NULL };
 	const char *what = optind < argc ? argv[optind] : NULL;
 	int known = 0, rc;
 	for (const char *const *w = words; what && *w && !known; w++)
 		known = !strcmp(*w, what);
 	if (!what)
-		return cli_usage_error(self, "missing the command: run, show, compare, ls or report");
+		return cli_usage_error(self, "missing the command: run, show, compare, ls, report or check");
 	if (!known)
-		return cli_usage_error(self, "unknown nightly command '%s': run, show, compare, ls or report", what);
+		return cli_usage_error(self, "unknown nightly command '%s': run, show, compare, ls, report or check", what);
 	if ((rc = check_options(self, what, o)))
 		return rc;
 	optind++;
@@ -507,6 +551,9 @@ static int nightly_dispatch(const struct subcommand *self, int argc, char **argv
 	if (!strcmp(what, "run"))
 		return (rc = cli_positional(self, argc, argv, 1, "the suite file SUITE.json")) ? rc
 											    : nightly_run(o, argv[optind]);
+	if (!strcmp(what, "check"))
+		return (rc = cli_positional(self, argc, argv, 1, "the suite file SUITE.json")) ? rc
+											    : nightly_check(o, argv[optind]);
 	if (!strcmp(what, "ls"))
 		return (rc = cli_positional(self, argc, argv, 0, "")) || (rc = cli_connect()) ? rc : nightly_ls(o);
 	if (!strcmp(what, "show")) {
@@ -532,6 +579,7 @@ int cmd_nightly(const struct subcommand *self, int argc, char **argv)
 		{ "only", required_argument, NULL, 'o' },  { "junit", required_argument, NULL, 'J' },
 		{ "html", required_argument, NULL, 'H' },  { "json", no_argument, NULL, 'j' },
 		{ "suite", required_argument, NULL, 's' }, { "limit", required_argument, NULL, 'n' },
+		{ "out", required_argument, NULL, 'O' },
 		{ "help", no_argument, NULL, 'h' },        { NULL, 0, NULL, 0 }
 	};
 	struct nightly_options o = { .limit = LS_LIMIT_DEFAULT };
@@ -545,6 +593,7 @@ int cmd_nightly(const struct subcommand *self, int argc, char **argv)
 		case 'H': o.html = optarg; break;
 		case 'j': o.json = 1; break;
 		case 's': o.suite = optarg; break;
+		case 'O': o.out = optarg; break;
 		case 'o':
 			if (o.only_count == ONLY_MAX)
 				return cli_usage_error(self, "at most %d --only", ONLY_MAX);

@@ -392,6 +392,26 @@ code=$(svc_req POST /v1/jobs "$user" -H 'Content-Type: application/json' \
 [ "$code" = 422 ] && grep -q '/case/confining_pressure' "$SVC_BODY"
 check submit_invalid_element_case_lists_problems $? "got $code $(head -c 300 "$SVC_BODY")"
 
+# the suites against schemas/suite.schema.json (Debian's python3-jsonschema), and every case of the
+# nightly's bench/suite.json as `poro nightly check` would submit it, valid for the solver
+"$PY3" - schemas/suite.schema.json bench/suite.json "$suite" <<'PY' > "$SVC_TMP/py" 2>&1
+import json, sys, jsonschema
+schema = json.load(open(sys.argv[1]))
+jsonschema.Draft202012Validator.check_schema(schema)
+for path in sys.argv[2:]:
+    jsonschema.validate(json.load(open(path)), schema)
+print("ok")
+PY
+check suites_match_their_schema $? "$(tail -3 "$SVC_TMP/py")"
+nightly check check bench/suite.json --out "$SVC_TMP/plan"
+ok=0 n=0
+for f in "$SVC_TMP"/plan/*.json; do
+	"$build/poro-solve" validate "$f" > /dev/null 2> "$SVC_TMP/validate.err" || { ok=1; cat "$SVC_TMP/validate.err"; }
+	n=$((n + 1))
+done
+check nightly_suite_cases_all_valid $(( rc != 0 || ok || n < 20 )) "exit $rc, $n cases: $(head -5 "$SVC_TMP/check.err")"
+echo "INFO bench/suite.json: $n cases, $(grep -c exclusive "$SVC_TMP/check.out") timed against history"
+
 # the CLI: a bad suite is refused before anything is sent, every problem named
 cp tests/cases/terzaghi.json "$SVC_TMP/terzaghi.json"
 python3 - "$SVC_TMP/bad-suite.json" "$SVC_TMP/terzaghi.json" <<'PY'
@@ -417,7 +437,8 @@ check cli_suite_not_json $(( rc != 6 )) "exit $rc: $(cat "$SVC_TMP/notjson.err")
 nightly onlymissing run "$suite" --only nosuchcase
 grep -q "no case named 'nosuchcase'" "$SVC_TMP/onlymissing.err"
 check cli_only_unknown_case $(( rc != 6 || $? != 0 )) "exit $rc: $(cat "$SVC_TMP/onlymissing.err")"
-for args in "report 1" "show x" "compare 1" "run" "frob" "ls --label x" "run $suite --label a/b" "show 1 --junit x.xml"; do
+for args in "report 1" "show x" "compare 1" "run" "frob" "ls --label x" "run $suite --label a/b" "show 1 --junit x.xml" \
+	"check" "show --out x"; do
 	# shellcheck disable=SC2086 # the words are arguments
 	nightly usage $args
 	check "cli_usage_${args//[^a-z0-9]/_}" $(( rc != 2 )) "exit $rc: $(cat "$SVC_TMP/usage.err")"
