@@ -432,7 +432,8 @@ done
 jobs_after=$(svc_req GET /v1/jobs "$user" > /dev/null; json '["jobs"][0]["id"]' < "$SVC_BODY")
 check cli_bad_suite_lists_every_problem $(( rc != 6 || ok || jobs_before != jobs_after )) \
 	"exit $rc: $(cat "$SVC_TMP/badsuite.err")"
-nightly notjson run "$SVC_TMP/pool.token"
+printf 'suite: not JSON\n' > "$SVC_TMP/notjson.txt"
+nightly notjson run "$SVC_TMP/notjson.txt"
 check cli_suite_not_json $(( rc != 6 )) "exit $rc: $(cat "$SVC_TMP/notjson.err")"
 nightly onlymissing run "$suite" --only nosuchcase
 grep -q "no case named 'nosuchcase'" "$SVC_TMP/onlymissing.err"
