@@ -306,9 +306,10 @@ static const char *against_text(const json_t *f, char out[64])
 {
 	const json_t *band = json_object_get(f, "band"), *stats = json_object_get(f, "stats");
 	char a[32], b[32];
+	const json_t *lo = json_array_get(band, 0), *hi = json_array_get(band, 1);
 	if (json_is_array(band))
-		snprintf(out, 64, "[%.24s, %.24s]", json_is_number(json_array_get(band, 0)) ? value_text(json_array_get(band, 0), a) : "",
-			 json_is_number(json_array_get(band, 1)) ? value_text(json_array_get(band, 1), b) : "");
+		snprintf(out, 64, "[%.24s, %.24s]", json_is_number(lo) ? value_text(lo, a) : "",
+			 json_is_number(hi) ? value_text(hi, b) : "");
 	else if (json_is_number(json_object_get(stats, "history_median")))
 		snprintf(out, 64, "%s (%lld samples)", value_text(json_object_get(stats, "history_median"), a),
 			 json_get_int(stats, "history_samples", 0));

@@ -306,7 +306,8 @@ static void html_head(FILE *f, const json_t *run)
 	escaped(f, json_get_str(run, "suite", ""));
 	fprintf(f, ", run %lld</title>\n", json_get_int(run, "id", 0));
 	fputs("<style>\nbody { font-family: sans-serif; margin: 24px; color: #222; }\n"
-	      "table { border-collapse: collapse; } td, th { padding: 3px 10px; border-bottom: 1px solid #ddd; text-align: left; }\n"
+	      "table { border-collapse: collapse; }\n"
+	      "td, th { padding: 3px 10px; border-bottom: 1px solid #ddd; text-align: left; }\n"
 	      ".regressed, .failed { color: #c62828; font-weight: bold; } .did_not_run { color: #8a6d00; }\n"
 	      ".ok { color: #1a7f37; } .improved { color: #2e7d32; } section { margin: 28px 0; }\n"
 	      "svg { border: 1px solid #ccc; background: #fff; }\n</style>\n</head>\n<body>\n", f);
@@ -338,7 +339,8 @@ void nightly_html(FILE *f, const json_t *run, json_t *const *series)
 	size_t i;
 	char value[32];
 	html_head(f, run);
-	fputs("<table>\n<tr><th>figure</th><th>check</th><th>value</th><th>unit</th><th>verdict</th><th>detail</th></tr>\n", f);
+	fputs("<table>\n<tr><th>figure</th><th>check</th><th>value</th><th>unit</th><th>verdict</th>"
+	      "<th>detail</th></tr>\n", f);
 	json_array_foreach(json_object_get(run, "figures"), i, fig) {
 		const char *status = json_get_str(fig, "status", "?");
 		fprintf(f, "<tr><td><a href=\"#f%zu\">", i);
