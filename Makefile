@@ -1,11 +1,16 @@
 # PoroMPM - one boring Makefile.
-#   make run     install what is missing, build, run the Terzaghi example and report its error
+#   make run     install what is missing, build what it runs, run the Terzaghi example and report
+#                its error
 #   make test    unit tests, reduced-size verification, bad-input tests; ends "N passed, N failed"
 #   make verify  paper-size verification runs (long)
 #   make bench   speed figures (printed, never asserted)
 #   make test SAN=1   the same tests under AddressSanitizer + UBSan
 #   make test-san     the service's tests alone under AddressSanitizer + UBSan (docs/service.md §6)
+#   make install [PREFIX=/usr/local] [DESTDIR=]   programs, systemd units, man pages, completions
+#   make uninstall    removes what make install put there
 # Every public target first runs deploy/deps.sh, which returns at once when nothing is missing.
+# They build with one job per core and print one short line per file ("  CC      build/x.o");
+# V=1 prints the whole commands instead.
 
 CC      ?= cc
 BUILD   ?= build$(if $(SAN),-san)
@@ -19,6 +24,14 @@ VERSION := $(shell git describe --always --dirty --tags 2>/dev/null || echo unkn
 CFLAGS  = -std=c11 $(OPT) -g -fopenmp $(WARN) $(SANFLAGS)
 LDLIBS  = $(shell pkg-config --libs $(PKGS) 2>/dev/null) -lcholmod -lm
 LDFLAGS = -fopenmp $(SANFLAGS)
+
+# One line per file unless V=1: $(call quiet,CC) before a command prints "  CC      TARGET" and
+# hides the command. The public targets run their build in a sub-make with one job per core,
+# unless the caller already gave -j (then its job server is used).
+V ?=
+quiet = $(if $(filter 1,$(V)),,@printf '  %-7s %s\n' '$(1)' '$@';)
+JOBS ?= $(shell nproc 2>/dev/null || echo 1)
+SUBMAKE_FLAGS = --no-print-directory $(if $(findstring jobserver,$(MAKEFLAGS)),,-j$(JOBS))
 
 # solver/ (README, "Layout"): the simulation object and its run loop at the top; case/ reads and
 # validates a case; material/ the constitutive models; mpm/ the grid, points, shape functions,
@@ -53,23 +66,31 @@ SERVER_LIBS = -lmicrohttpd -lsqlite3 -lm $(SVC_LIBS)
 SERVICE    = $(if $(SERVER_OBJ),$(BUILD)/poro-server) $(if $(WORKER_OBJ),$(BUILD)/poro-worker) \
 	     $(if $(CLIENT_OBJ),$(BUILD)/poro $(BUILD)/poro-load)
 
-.PHONY: all deps run test test-san verify bench clean build-all build-service format
+.PHONY: all deps run test test-san verify bench clean build-all build-run build-service format install uninstall
 .DEFAULT_GOAL := all
+# objects made on the way to a program are kept: deleting them would only rebuild them next time
+.SECONDARY:
 
 deps:
 	@bash deploy/deps.sh
 
 all: deps
-	@$(MAKE) --no-print-directory build-all
+	@$(MAKE) $(SUBMAKE_FLAGS) build-all
 
 build-all: $(POROSOLVE) $(TEST_BIN) $(COMMON_TEST_BIN) $(BENCH_BIN) $(TOOLS) $(SERVICE)
 
+# What tests/run_example.sh runs: the server, a worker, the poro CLI, the solver and the error
+# against Terzaghi's closed form; no test program.
+RUN_BIN = $(POROSOLVE) $(BUILD)/terzaghi-error $(BUILD)/poro-server $(BUILD)/poro-worker $(BUILD)/poro
+
+build-run: $(RUN_BIN)
+
 run: deps
-	@$(MAKE) --no-print-directory build-all
+	@$(MAKE) $(SUBMAKE_FLAGS) build-run
 	@bash tests/run_example.sh $(BUILD)
 
 test: deps
-	@$(MAKE) --no-print-directory build-all
+	@$(MAKE) $(SUBMAKE_FLAGS) build-all
 	@bash tests/run.sh $(BUILD) test
 
 # The service's binaries, poro-solve (the workers run it) and the tests of common/: what the
@@ -77,30 +98,30 @@ test: deps
 build-service: $(POROSOLVE) $(COMMON_TEST_BIN) $(SERVICE)
 
 test-san: deps
-	@$(MAKE) --no-print-directory SAN=1 build-service
+	@$(MAKE) $(SUBMAKE_FLAGS) SAN=1 build-service
 	@bash tests/run.sh build-san service
 
 verify: deps
-	@$(MAKE) --no-print-directory build-all
+	@$(MAKE) $(SUBMAKE_FLAGS) build-all
 	@bash tests/run.sh $(BUILD) verify
 
 bench: deps
-	@$(MAKE) --no-print-directory build-all
+	@$(MAKE) $(SUBMAKE_FLAGS) build-all
 	@bash bench/run.sh $(BUILD)
 
 $(BUILD)/%.o: %.c $(SOLVER_HDR) $(wildcard tests/*.h tests/verify/*.h common/*.h client/*.h server/*.h worker/*.h)
 	@mkdir -p $(dir $@)
-	$(CC) $(CPPFLAGS) -Icommon -Iclient $(CFLAGS) -c $< -o $@
+	$(call quiet,CC)$(CC) $(CPPFLAGS) -Icommon -Iclient $(CFLAGS) -c $< -o $@
 
 $(LIBPORO): $(SOLVER_OBJ)
 	@rm -f $@
-	ar rcs $@ $^
+	$(call quiet,AR)ar rcs $@ $^
 
 $(POROSOLVE): $(BUILD)/cli/poro_solve.o $(LIBPORO)
-	$(CC) $(LDFLAGS) $^ $(LDLIBS) -o $@
+	$(call quiet,LD)$(CC) $(LDFLAGS) $^ $(LDLIBS) -o $@
 
 $(BUILD)/terzaghi-error: $(BUILD)/tools/terzaghi_error.o $(LIBPORO)
-	$(CC) $(LDFLAGS) $^ $(LDLIBS) -o $@
+	$(call quiet,LD)$(CC) $(LDFLAGS) $^ $(LDLIBS) -o $@
 
 $(BUILD)/tools/terzaghi_error.o: tests/verify/analytic.h
 
@@ -108,28 +129,28 @@ $(BUILD)/tools/terzaghi_error.o: tests/verify/analytic.h
 # it calls for the run-out picture.
 $(BUILD)/poro-plot: cli/poro_plot.py
 	@mkdir -p $(dir $@)
-	cp $< $@ && chmod +x $@
+	$(call quiet,GEN)cp $< $@ && chmod +x $@
 
 $(BUILD)/tests/%: $(BUILD)/tests/%.o $(LIBPORO)
-	$(CC) $(LDFLAGS) $^ $(LDLIBS) -o $@
+	$(call quiet,LD)$(CC) $(LDFLAGS) $^ $(LDLIBS) -o $@
 
 $(BUILD)/tests/common/%: $(BUILD)/tests/common/%.o $(COMMON_OBJ)
-	$(CC) $(LDFLAGS) $^ $(SVC_LIBS) -o $@
+	$(call quiet,LD)$(CC) $(LDFLAGS) $^ $(SVC_LIBS) -o $@
 
 $(BUILD)/bench/%: $(BUILD)/bench/%.o $(LIBPORO)
-	$(CC) $(LDFLAGS) $^ $(LDLIBS) -o $@
+	$(call quiet,LD)$(CC) $(LDFLAGS) $^ $(LDLIBS) -o $@
 
 $(BUILD)/poro-server: $(SERVER_OBJ) $(COMMON_OBJ) $(LIBPORO)
-	$(CC) $(LDFLAGS) $^ $(SERVER_LIBS) -o $@
+	$(call quiet,LD)$(CC) $(LDFLAGS) $^ $(SERVER_LIBS) -o $@
 
 $(BUILD)/poro-worker: $(WORKER_OBJ) $(CLIENT_OBJ) $(COMMON_OBJ)
-	$(CC) $(LDFLAGS) $^ -lcurl $(SVC_LIBS) -o $@
+	$(call quiet,LD)$(CC) $(LDFLAGS) $^ -lcurl $(SVC_LIBS) -o $@
 
 $(BUILD)/poro: $(BUILD)/cli/poro.o $(CLIENT_OBJ) $(COMMON_OBJ)
-	$(CC) $(LDFLAGS) $^ -lcurl $(SVC_LIBS) -lm -o $@
+	$(call quiet,LD)$(CC) $(LDFLAGS) $^ -lcurl $(SVC_LIBS) -lm -o $@
 
 $(BUILD)/poro-load: $(BUILD)/bench/poro_load.o $(CLIENT_OBJ) $(COMMON_OBJ)
-	$(CC) $(LDFLAGS) $^ -lcurl $(SVC_LIBS) -lm -o $@
+	$(call quiet,LD)$(CC) $(LDFLAGS) $^ -lcurl $(SVC_LIBS) -lm -o $@
 
 # Formats the lines changed since FORMAT_BASE (default HEAD: the uncommitted work) by .clang-format;
 # `make format FORMAT_BASE=origin/main` takes a whole branch. Needs Debian's clang-format.
