@@ -15,6 +15,7 @@
  */
 #include "file_sweep.h"
 #include "http.h"
+#include "log.h"
 #include "metrics.h"
 #include "reaper.h"
 #include "state_dir.h"
@@ -74,7 +75,7 @@ static const struct option_def OPTIONS[] = {
 	INT_OPT("max-backoff-seconds", max_backoff_seconds, 1, 86400, "cap of the retry backoff min(2^(attempt-1), cap) (default 60)"),
 	INT_OPT("group-commit-max", group_commit_max, 1, 100000, "most write requests in one transaction (default 1024)"),
 	INT_OPT("max-job-threads", max_job_threads, 1, 256, "most threads a job may ask for (default 64)"),
-	TEXT_OPT("access-log", access_log, "append 'METHOD ROUTE STATUS MILLISECONDS' per request to FILE (default none)"),
+	TEXT_OPT("access-log", access_log, "append the log's request lines (logfmt) to FILE too (default none)"),
 	LONG_OPT("max-log-bytes", max_log_bytes, 65536, 1LL << 50, "log text kept per attempt: its first and last half (default 67108864)"),
 	LONG_OPT("user-max-stored-bytes", user_max_stored_bytes, 0, 1LL << 60, "default per-user cap on stored bytes (cases, logs, files), 0 = unlimited (default 2147483648)"),
 	INT_OPT("min-free-mb", min_free_mb, 0, 1 << 30, "/healthz is degraded below this free space on the state file system, MiB (default 64)"),
@@ -116,7 +117,7 @@ static int set_option(struct server_config *cfg, const char *name, const char *v
 		char *field = (char *)cfg + o->offset;
 		if (o->type == OPT_TEXT) {
 			if (strlen(value) >= o->size || !value[0]) {
-				fprintf(stderr, "poro-server: %s: value of '%s' is empty or too long\n", where, name);
+				log_say(LOG_PRIO_ERR, "%s: value of '%s' is empty or too long", where, name);
 				return -1;
 			}
 			memcpy(field, value, strlen(value) + 1);
@@ -126,8 +127,8 @@ static int set_option(struct server_config *cfg, const char *name, const char *v
 		errno = 0;
 		long long v = strtoll(value, &end, 10);
 		if (errno || end == value || *end || v < o->min || v > o->max) {
-			fprintf(stderr, "poro-server: %s: '%s' must be an integer in %lld..%lld, got '%s'\n", where, name,
-				o->min, o->max, value);
+			log_say(LOG_PRIO_ERR, "%s: '%s' must be an integer in %lld..%lld, got '%s'", where, name, o->min,
+				o->max, value);
 			return -1;
 		}
 		if (o->type == OPT_INT)
@@ -136,7 +137,7 @@ static int set_option(struct server_config *cfg, const char *name, const char *v
 			*(long long *)(void *)field = v;
 		return 0;
 	}
-	fprintf(stderr, "poro-server: %s: unknown option '%s'\n", where, name);
+	log_say(LOG_PRIO_ERR, "%s: unknown option '%s'", where, name);
 	return -1;
 }
 
@@ -154,7 +155,7 @@ static int read_config(struct server_config *cfg, const char *path)
 {
 	FILE *f = fopen(path, "r");
 	if (!f) {
-		fprintf(stderr, "poro-server: cannot open config file '%s': %s\n", path, strerror(errno));
+		log_say(LOG_PRIO_ERR, "cannot open config file '%s': %s", path, strerror(errno));
 		return -1;
 	}
 	char line[8192], where[SERVER_PATH_MAX + 32];
@@ -167,7 +168,7 @@ static int read_config(struct server_config *cfg, const char *path)
 		char *eq = strchr(s, '=');
 		snprintf(where, sizeof where, "%s:%d", path, number);
 		if (!eq) {
-			fprintf(stderr, "poro-server: %s: expected 'name = value'\n", where);
+			log_say(LOG_PRIO_ERR, "%s: expected 'name = value'", where);
 			rc = -1;
 			break;
 		}
@@ -216,20 +217,20 @@ static int open_state(struct server *srv, int *lock_fd)
 	const char *state = srv->cfg.state;
 	char msg[SERVER_MESSAGE_MAX], files[SERVER_PATH_MAX];
 	if (fs_make_dirs(state) != 0) {
-		fprintf(stderr, "poro-server: cannot create state directory '%s': %s\n", state, strerror(errno));
+		log_say(LOG_PRIO_ERR, "cannot create state directory '%s': %s", state, strerror(errno));
 		return -1;
 	}
 	if ((*lock_fd = state_dir_lock(state, msg, sizeof msg)) < 0) {
-		fprintf(stderr, "poro-server: %s\n", msg);
+		log_say(LOG_PRIO_ERR, "%s", msg);
 		return -1;
 	}
 	state_dir_restrict(state);
 	/* /healthz creates its probe file here, so files/ exists before the first upload */
 	snprintf(files, sizeof files, "%s/files", state);
 	if (fs_make_dirs(files) != 0)
-		fprintf(stderr, "poro-server: cannot create '%s': %s\n", files, strerror(errno));
+		log_say(LOG_PRIO_WARNING, "cannot create '%s': %s", files, strerror(errno));
 	if (state_dir_open_store(&srv->cfg, srv, &srv->store, msg, sizeof msg) != 0) {
-		fprintf(stderr, "poro-server: %s\n", msg);
+		log_say(LOG_PRIO_ERR, "%s", msg);
 		return -1;
 	}
 	return 0;
@@ -267,11 +268,11 @@ static void sweep_files(struct server *srv)
 {
 	struct sweep_counts n;
 	if (file_sweep_startup(srv->cfg.state, srv->store, &n) != 0) {
-		fprintf(stderr, "poro-server: cannot sweep '%s/files': %s\n", srv->cfg.state, strerror(errno));
+		log_say(LOG_PRIO_WARNING, "cannot sweep '%s/files': %s", srv->cfg.state, strerror(errno));
 		return;
 	}
-	fprintf(stderr, "poro-server: start-up sweep of '%s/files': removed temporary upload files: %lld (%lld bytes); "
-		"directories of deleted jobs: %lld (%lld bytes)\n", srv->cfg.state, n.tmp_files, n.tmp_bytes, n.job_dirs,
+	log_say(LOG_PRIO_INFO, "start-up sweep of '%s/files': removed temporary upload files: %lld (%lld bytes); "
+		"directories of deleted jobs: %lld (%lld bytes)", srv->cfg.state, n.tmp_files, n.tmp_bytes, n.job_dirs,
 		n.job_bytes);
 }
 
@@ -301,16 +302,17 @@ static int serve(struct server *srv)
 	char url[512], msg[SERVER_MESSAGE_MAX];
 	void *daemon = http_start(srv, url, sizeof url, msg, sizeof msg);
 	if (!daemon) {
-		fprintf(stderr, "poro-server: %s\n", msg);
+		log_say(LOG_PRIO_ERR, "%s", msg);
 		store_close(&srv->store);
 		close(lock_fd);
 		return 1;
 	}
 	if (write_url(srv->cfg.state, url) != 0)
-		fprintf(stderr, "poro-server: cannot write '%s/server.url': %s\n", srv->cfg.state, strerror(errno));
+		log_say(LOG_PRIO_ERR, "cannot write '%s/server.url': %s", srv->cfg.state, strerror(errno));
 	struct reaper *reaper = reaper_start(srv);
 	printf("poro-server listening on %s\n", url);
 	fflush(stdout);
+	log_say(LOG_PRIO_NOTICE, "listening on %s (version %s, state directory '%s')", url, PORO_VERSION, srv->cfg.state);
 
 	int sig = 0;
 	sigwait(&signals, &sig);
@@ -324,13 +326,14 @@ static int serve(struct server *srv)
 	http_stop(daemon);          /* waits for in-flight requests, whose writes commit first */
 	store_close(&srv->store);   /* drains the writer, checkpoints, closes */
 	close(lock_fd);             /* another server may take the state directory from here on */
-	fprintf(stderr, "poro-server: stopped on signal %d\n", sig);
+	log_say(LOG_PRIO_NOTICE, "stopped on signal %d (%s)", sig, strsignal(sig));
 	return 0;
 }
 
 int main(int argc, char **argv)
 {
 	umask(077);                 /* see the top of this file and state_dir.c */
+	log_setup();
 	signal(SIGXFSZ, SIG_IGN);
 	if (argc >= 2 && strcmp(argv[1], "token") == 0)
 		return token_command(argc, argv, &CONFIG_DEFAULTS);
@@ -344,11 +347,12 @@ int main(int argc, char **argv)
 	srv.access_log_fd = -1;
 	if (srv.cfg.access_log[0] &&
 	    (srv.access_log_fd = open(srv.cfg.access_log, O_WRONLY | O_CREAT | O_APPEND | O_CLOEXEC, 0644)) < 0) {
-		fprintf(stderr, "poro-server: cannot open --access-log '%s': %s\n", srv.cfg.access_log, strerror(errno));
+		log_say(LOG_PRIO_ERR, "cannot open --access-log '%s': %s", srv.cfg.access_log, strerror(errno));
 		return 2;
 	}
+	log_set_access_fd(srv.access_log_fd);
 	if (!srv.metrics) {
-		fprintf(stderr, "poro-server: out of memory\n");
+		log_say(LOG_PRIO_ERR, "out of memory");
 		return 1;
 	}
 	int rc = serve(&srv);
