@@ -66,10 +66,10 @@ SERVER_LIBS = -lmicrohttpd -lsqlite3 -lm $(SVC_LIBS)
 SERVICE    = $(if $(SERVER_OBJ),$(BUILD)/poro-server) $(if $(WORKER_OBJ),$(BUILD)/poro-worker) \
 	     $(if $(CLIENT_OBJ),$(BUILD)/poro $(BUILD)/poro-load)
 
-.PHONY: all deps run test test-san verify bench clean build-all build-run build-service format install uninstall
+.PHONY: FORCE all deps run test test-san verify bench clean build-all build-run build-service format install uninstall
 .DEFAULT_GOAL := all
 # objects made on the way to a program are kept: deleting them would only rebuild them next time
-.SECONDARY:
+.PRECIOUS: $(BUILD)/%.o
 
 deps:
 	@bash deploy/deps.sh
@@ -112,6 +112,16 @@ bench: deps
 $(BUILD)/%.o: %.c $(SOLVER_HDR) $(wildcard tests/*.h tests/verify/*.h common/*.h client/*.h server/*.h worker/*.h)
 	@mkdir -p $(dir $@)
 	$(call quiet,CC)$(CC) $(CPPFLAGS) -Icommon -Iclient $(CFLAGS) -c $< -o $@
+
+# The files that print the version (PORO_VERSION, from git describe) are compiled again when it
+# changes, as after a commit: $(BUILD)/version.stamp holds the version they were built with and is
+# rewritten only when it differs, so an unchanged version rebuilds nothing.
+VERSION_OBJ = $(patsubst %.c,$(BUILD)/%.o,$(shell grep -l PORO_VERSION $(SOLVER_SRC) cli/*.c server/*.c worker/*.c 2>/dev/null))
+$(VERSION_OBJ): $(BUILD)/version.stamp
+$(BUILD)/version.stamp: FORCE
+	@mkdir -p $(dir $@)
+	@[ "$$(cat $@ 2>/dev/null)" = "$(VERSION)" ] || echo "$(VERSION)" > $@
+FORCE:
 
 $(LIBPORO): $(SOLVER_OBJ)
 	@rm -f $@

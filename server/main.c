@@ -11,7 +11,9 @@
  * and the upload path report as an error answer, instead of killing the server.
  *
  * Every option is one row of OPTIONS: the flag name, which is also the key in the config file
- * ("name = value" lines, '#' comments), the field it sets, its default and its help text.
+ * ("name = value" lines, '#' comments), the field it sets, its default and its help text. The
+ * command line is read by getopt_long (--opt=value or --opt value, abbreviations, "--"); --help
+ * and --version print on stdout and exit 0, a bad command line or config file exits 2.
  */
 #include "file_sweep.h"
 #include "http.h"
@@ -26,8 +28,10 @@
 
 #include <errno.h>
 #include <fcntl.h>
+#include <getopt.h>
 #include <malloc.h>
 #include <signal.h>
+#include <stdarg.h>
 #include <stddef.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -42,6 +46,7 @@ enum option_type { OPT_TEXT, OPT_INT, OPT_LONG };
 
 struct option_def {
 	const char *name;
+	const char *arg;         /* the value's name in --help */
 	enum option_type type;
 	size_t offset;           /* in struct server_config */
 	size_t size;             /* OPT_TEXT: buffer size */
@@ -49,13 +54,13 @@ struct option_def {
 	const char *help;
 };
 
-#define TEXT_OPT(n, f, h) { n, OPT_TEXT, offsetof(struct server_config, f), sizeof((struct server_config *)0)->f, 0, 0, h }
-#define INT_OPT(n, f, lo, hi, h) { n, OPT_INT, offsetof(struct server_config, f), 0, lo, hi, h }
-#define LONG_OPT(n, f, lo, hi, h) { n, OPT_LONG, offsetof(struct server_config, f), 0, lo, hi, h }
+#define TEXT_OPT(n, a, f, h) { n, a, OPT_TEXT, offsetof(struct server_config, f), sizeof((struct server_config *)0)->f, 0, 0, h }
+#define INT_OPT(n, f, lo, hi, h) { n, "N", OPT_INT, offsetof(struct server_config, f), 0, lo, hi, h }
+#define LONG_OPT(n, f, lo, hi, h) { n, "N", OPT_LONG, offsetof(struct server_config, f), 0, lo, hi, h }
 
 static const struct option_def OPTIONS[] = {
-	TEXT_OPT("listen", listen, "HOST:PORT to listen on; port 0 picks a free one (default 127.0.0.1:8080)"),
-	TEXT_OPT("state", state, "state directory: poro.db, files/, server.url (default ./var)"),
+	TEXT_OPT("listen", "HOST:PORT", listen, "HOST:PORT to listen on; port 0 picks a free one (default 127.0.0.1:8080)"),
+	TEXT_OPT("state", "DIR", state, "state directory: poro.db, files/, server.url (default ./var)"),
 	INT_OPT("max-connections", max_connections, 1, 100000, "connections of users and clients without a token, one thread each (default 512)"),
 	INT_OPT("max-worker-connections", max_worker_connections, 1, 100000, "connections of worker tokens on /v1/worker/ routes, kept apart (default 256)"),
 	INT_OPT("max-connections-per-client", max_connections_per_client, 1, 100000, "user connections from one client address, waiting ones included (default 128)"),
@@ -75,7 +80,7 @@ static const struct option_def OPTIONS[] = {
 	INT_OPT("max-backoff-seconds", max_backoff_seconds, 1, 86400, "cap of the retry backoff min(2^(attempt-1), cap) (default 60)"),
 	INT_OPT("group-commit-max", group_commit_max, 1, 100000, "most write requests in one transaction (default 1024)"),
 	INT_OPT("max-job-threads", max_job_threads, 1, 256, "most threads a job may ask for (default 64)"),
-	TEXT_OPT("access-log", access_log, "append the log's request lines (logfmt) to FILE too (default none)"),
+	TEXT_OPT("access-log", "FILE", access_log, "append the log's request lines (logfmt) to FILE too (default none)"),
 	LONG_OPT("max-log-bytes", max_log_bytes, 65536, 1LL << 50, "log text kept per attempt: its first and last half (default 67108864)"),
 	LONG_OPT("user-max-stored-bytes", user_max_stored_bytes, 0, 1LL << 60, "default per-user cap on stored bytes (cases, logs, files), 0 = unlimited (default 2147483648)"),
 	INT_OPT("min-free-mb", min_free_mb, 0, 1 << 30, "/healthz is degraded below this free space on the state file system, MiB (default 64)"),
@@ -94,21 +99,30 @@ static const struct server_config CONFIG_DEFAULTS = {
 	.min_free_mb = 64,
 };
 
-static void usage(FILE *out)
+static void usage(void)
 {
-	fprintf(out, "usage: poro-server [--config FILE] [--OPTION VALUE ...]\n"
-		     "       poro-server token create --state DIR --user NAME --role user|worker|admin [--label TEXT]\n"
-		     "       poro-server token list --state DIR\n"
-		     "       poro-server token revoke --state DIR --id N\n\n"
-		     "The HTTP job server of PoroMPM (docs/service.md). Every option may also be a line\n"
-		     "'name = value' in the config file; flags win over the file.\n\n"
-		     "options:\n  --config FILE  read options from FILE\n");
-	for (size_t i = 0; i < OPTION_COUNT; i++)
-		fprintf(out, "  --%-20s %s\n", OPTIONS[i].name, OPTIONS[i].help);
-	fprintf(out, "  --help                 this text\n  --version              print the version\n");
+	printf("usage: poro-server [--config=FILE] [--OPTION=VALUE ...]\n"
+	       "       poro-server token create --state=DIR --user=NAME --role=user|worker|admin [--label=TEXT]\n"
+	       "       poro-server token list --state=DIR\n"
+	       "       poro-server token revoke --state=DIR --id=N\n\n"
+	       "The HTTP job server of PoroMPM (docs/service.md). Every option may also be a line\n"
+	       "'name = value' in the config file; options on the command line win over the file.\n"
+	       "--opt=VALUE and --opt VALUE are the same.\n\n"
+	       "options:\n  --config=FILE                          read options from FILE\n");
+	for (size_t i = 0; i < OPTION_COUNT; i++) {
+		char flag[64];
+		snprintf(flag, sizeof flag, "--%s=%s", OPTIONS[i].name, OPTIONS[i].arg);
+		printf("  %-38s %s\n", flag, OPTIONS[i].help);
+	}
+	printf("  %-38s %s\n  %-38s %s\n\n", "-h, --help", "this text", "--version", "print the version");
+	printf("The log (stderr): one logfmt line per request, job state change and message; with the\n"
+	       "systemd journal's priority prefix when stderr is the journal. SIGTERM or SIGINT stops the\n"
+	       "server cleanly. Exit status: 0 after a signal, 1 when it cannot start, 2 for a bad command\n"
+	       "line or configuration.\n");
 }
 
-static int set_option(struct server_config *cfg, const char *name, const char *value, const char *where)
+/* Sets option name to value; 0, or -1 with the reason in why. */
+static int set_option(struct server_config *cfg, const char *name, const char *value, char *why, size_t why_size)
 {
 	for (size_t i = 0; i < OPTION_COUNT; i++) {
 		const struct option_def *o = &OPTIONS[i];
@@ -117,7 +131,7 @@ static int set_option(struct server_config *cfg, const char *name, const char *v
 		char *field = (char *)cfg + o->offset;
 		if (o->type == OPT_TEXT) {
 			if (strlen(value) >= o->size || !value[0]) {
-				log_say(LOG_PRIO_ERR, "%s: value of '%s' is empty or too long", where, name);
+				snprintf(why, why_size, "value of '%s' is empty or too long", name);
 				return -1;
 			}
 			memcpy(field, value, strlen(value) + 1);
@@ -127,8 +141,8 @@ static int set_option(struct server_config *cfg, const char *name, const char *v
 		errno = 0;
 		long long v = strtoll(value, &end, 10);
 		if (errno || end == value || *end || v < o->min || v > o->max) {
-			log_say(LOG_PRIO_ERR, "%s: '%s' must be an integer in %lld..%lld, got '%s'", where, name, o->min,
-				o->max, value);
+			snprintf(why, why_size, "'%s' must be an integer in %lld..%lld, got '%s'", name, o->min, o->max,
+				 value);
 			return -1;
 		}
 		if (o->type == OPT_INT)
@@ -137,7 +151,7 @@ static int set_option(struct server_config *cfg, const char *name, const char *v
 			*(long long *)(void *)field = v;
 		return 0;
 	}
-	log_say(LOG_PRIO_ERR, "%s: unknown option '%s'", where, name);
+	snprintf(why, why_size, "unknown option '%s'", name);
 	return -1;
 }
 
@@ -173,40 +187,76 @@ static int read_config(struct server_config *cfg, const char *path)
 			break;
 		}
 		*eq = '\0';
-		rc = set_option(cfg, trim(s), trim(eq + 1), where);
+		char why[SERVER_MESSAGE_MAX];
+		if ((rc = set_option(cfg, trim(s), trim(eq + 1), why, sizeof why)) != 0)
+			log_say(LOG_PRIO_ERR, "%s: %s", where, why);
 	}
 	fclose(f);
 	return rc;
 }
 
-/* Config file first (wherever --config appears), then the flags over it. */
+/* A bad command line: the message, the hint; -1. */
+static int bad_usage(const char *fmt, ...) __attribute__((format(printf, 1, 2)));
+static int bad_usage(const char *fmt, ...)
+{
+	va_list ap;
+	va_start(ap, fmt);
+	fprintf(stderr, "poro-server: ");
+	vfprintf(stderr, fmt, ap);
+	va_end(ap);
+	fprintf(stderr, "\nTry 'poro-server --help' for more information.\n");
+	return -1;
+}
+
+enum { LONG_CONFIG = 256, LONG_VERSION, LONG_FIRST_OPTION }; /* OPTIONS[i] is LONG_FIRST_OPTION + i */
+
+/* getopt_long's table: every row of OPTIONS, --config, --help, --version. */
+static void long_options(struct option *out)
+{
+	size_t n = 0;
+	for (size_t i = 0; i < OPTION_COUNT; i++)
+		out[n++] = (struct option){ OPTIONS[i].name, required_argument, NULL, LONG_FIRST_OPTION + (int)i };
+	out[n++] = (struct option){ "config", required_argument, NULL, LONG_CONFIG };
+	out[n++] = (struct option){ "help", no_argument, NULL, 'h' };
+	out[n++] = (struct option){ "version", no_argument, NULL, LONG_VERSION };
+	out[n] = (struct option){ NULL, 0, NULL, 0 };
+}
+
+/* The config file first (wherever --config appears), then the options over it: two passes of
+ * getopt_long, so --opt=value, --opt value and unambiguous abbreviations all work (GNU habits).
+ * --help and --version answer at once, exit 0. */
 static int parse_args(struct server_config *cfg, int argc, char **argv)
 {
 	*cfg = CONFIG_DEFAULTS;
-	for (int i = 1; i < argc; i++)
-		if (strcmp(argv[i], "--config") == 0) {
-			if (i + 1 >= argc || read_config(cfg, argv[i + 1]) != 0)
-				return i + 1 >= argc ? (fprintf(stderr, "poro-server: --config needs a file\n"), -1) : -1;
-			i++;
+	struct option longs[OPTION_COUNT + 4];
+	long_options(longs);
+	opterr = 0; /* bad_usage says what getopt would, with the hint */
+	for (int pass = 0; pass < 2; pass++) {
+		optind = 0; /* GNU: start the scan afresh */
+		int opt;
+		while ((opt = getopt_long(argc, argv, ":h", longs, NULL)) != -1) {
+			char why[SERVER_MESSAGE_MAX];
+			if (opt == 'h') {
+				usage();
+				exit(0);
+			} else if (opt == LONG_VERSION) {
+				printf("poro-server %s\n", PORO_VERSION);
+				exit(0);
+			} else if (opt == ':') {
+				return bad_usage("option '%s' needs a value", argv[optind - 1]);
+			} else if (opt == '?') {
+				return bad_usage("unknown option '%s'", argv[optind - 1]);
+			} else if (opt == LONG_CONFIG) {
+				if (pass == 0 && read_config(cfg, optarg) != 0)
+					return -1;
+			} else if (pass == 1 && set_option(cfg, OPTIONS[opt - LONG_FIRST_OPTION].name, optarg, why,
+							   sizeof why) != 0) {
+				return bad_usage("%s", why);
+			}
 		}
-	for (int i = 1; i < argc; i++) {
-		const char *a = argv[i];
-		if (strcmp(a, "--help") == 0 || strcmp(a, "-h") == 0) {
-			usage(stdout);
-			exit(0);
-		}
-		if (strcmp(a, "--version") == 0) {
-			printf("poro-server %s\n", PORO_VERSION);
-			exit(0);
-		}
-		if (strncmp(a, "--", 2) != 0 || i + 1 >= argc) {
-			fprintf(stderr, "poro-server: unexpected argument '%s' (see --help)\n", a);
-			return -1;
-		}
-		if (strcmp(a, "--config") != 0 && set_option(cfg, a + 2, argv[i + 1], "command line") != 0)
-			return -1;
-		i++;
 	}
+	if (optind < argc)
+		return bad_usage("unexpected argument '%s'", argv[optind]);
 	return 0;
 }
 
