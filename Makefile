@@ -66,7 +66,8 @@ SERVER_LIBS = -lmicrohttpd -lsqlite3 -lm $(SVC_LIBS)
 SERVICE    = $(if $(SERVER_OBJ),$(BUILD)/poro-server) $(if $(WORKER_OBJ),$(BUILD)/poro-worker) \
 	     $(if $(CLIENT_OBJ),$(BUILD)/poro $(BUILD)/poro-load)
 
-.PHONY: FORCE all deps run test test-san verify bench clean build-all build-run build-service format install uninstall
+.PHONY: FORCE all deps run test test-san verify bench clean build-all build-run build-service format install \
+	install-files build-install uninstall
 .DEFAULT_GOAL := all
 # objects made on the way to a program are kept: deleting them would only rebuild them next time
 .PRECIOUS: $(BUILD)/%.o
@@ -161,6 +162,59 @@ $(BUILD)/poro: $(BUILD)/cli/poro.o $(CLIENT_OBJ) $(COMMON_OBJ)
 
 $(BUILD)/poro-load: $(BUILD)/bench/poro_load.o $(CLIENT_OBJ) $(COMMON_OBJ)
 	$(call quiet,LD)$(CC) $(LDFLAGS) $^ -lcurl $(SVC_LIBS) -lm -o $@
+
+# make install [PREFIX=/usr/local] [DESTDIR=]: the programs, the systemd units (their @bindir@
+# replaced), the account they run as (sysusers.d), the configuration (only when none is there:
+# an operator's is never overwritten), the schemas, the man pages (version set), the bash
+# completions of poro and poro-solve, and web/ when it exists. make uninstall removes them and
+# leaves the configuration. Paths: docs/service.md §8.
+PREFIX      ?= /usr/local
+BINDIR      ?= $(PREFIX)/bin
+DATADIR     ?= $(PREFIX)/share
+MANDIR      ?= $(DATADIR)/man
+UNITDIR     ?= $(PREFIX)/lib/systemd/system
+SYSUSERSDIR ?= $(PREFIX)/lib/sysusers.d
+COMPLETIONDIR ?= $(DATADIR)/bash-completion/completions
+SYSCONFDIR  ?= /etc
+INSTALL_BIN = poro-server poro-worker poro poro-solve poro-plot
+UNITS       = $(patsubst deploy/systemd/%.in,%,$(wildcard deploy/systemd/*.in))
+MAN_PAGES   = $(notdir $(wildcard docs/man/*.1))
+COMPLETIONS = poro poro-solve
+SCHEMAS     = $(notdir $(wildcard schemas/*))
+
+build-install: $(addprefix $(BUILD)/,$(INSTALL_BIN))
+
+install: deps
+	@$(MAKE) $(SUBMAKE_FLAGS) build-install
+	@$(MAKE) --no-print-directory install-files
+
+install-files:
+	install -d $(DESTDIR)$(BINDIR) $(DESTDIR)$(UNITDIR) $(DESTDIR)$(SYSUSERSDIR) $(DESTDIR)$(MANDIR)/man1 \
+		$(DESTDIR)$(COMPLETIONDIR) $(DESTDIR)$(DATADIR)/poro/schemas $(DESTDIR)$(DATADIR)/poro/examples \
+		$(DESTDIR)$(SYSCONFDIR)/poro
+	install -m 755 $(addprefix $(BUILD)/,$(INSTALL_BIN)) $(DESTDIR)$(BINDIR)/
+	for u in $(UNITS); do \
+		sed -e 's|@bindir@|$(BINDIR)|g' -e 's|/etc/poro/|$(SYSCONFDIR)/poro/|g' deploy/systemd/$$u.in > $(DESTDIR)$(UNITDIR)/$$u && \
+		chmod 644 $(DESTDIR)$(UNITDIR)/$$u || exit 1; done
+	install -m 644 deploy/sysusers.d/poro.conf $(DESTDIR)$(SYSUSERSDIR)/poro.conf
+	for m in $(MAN_PAGES); do \
+		sed 's|@VERSION@|$(VERSION)|g' docs/man/$$m > $(DESTDIR)$(MANDIR)/man1/$$m && \
+		chmod 644 $(DESTDIR)$(MANDIR)/man1/$$m || exit 1; done
+	install -m 644 $(addprefix deploy/bash-completion/,$(COMPLETIONS)) $(DESTDIR)$(COMPLETIONDIR)/
+	install -m 644 $(addprefix schemas/,$(SCHEMAS)) $(DESTDIR)$(DATADIR)/poro/schemas/
+	install -m 644 deploy/poro-server.conf.example $(DESTDIR)$(DATADIR)/poro/examples/poro-server.conf
+	install -m 644 deploy/worker.env.example $(DESTDIR)$(DATADIR)/poro/examples/worker.env
+	[ -e $(DESTDIR)$(SYSCONFDIR)/poro/poro-server.conf ] || \
+		install -m 644 deploy/poro-server.conf.example $(DESTDIR)$(SYSCONFDIR)/poro/poro-server.conf
+	if [ -d web ]; then install -d $(DESTDIR)$(DATADIR)/poro/web && cp -R web/. $(DESTDIR)$(DATADIR)/poro/web/; fi
+
+uninstall:
+	rm -f $(addprefix $(DESTDIR)$(BINDIR)/,$(INSTALL_BIN)) $(addprefix $(DESTDIR)$(UNITDIR)/,$(UNITS)) \
+		$(DESTDIR)$(SYSUSERSDIR)/poro.conf $(addprefix $(DESTDIR)$(MANDIR)/man1/,$(MAN_PAGES)) \
+		$(addprefix $(DESTDIR)$(COMPLETIONDIR)/,$(COMPLETIONS))
+	rm -rf $(DESTDIR)$(DATADIR)/poro
+	@[ ! -e $(DESTDIR)$(SYSCONFDIR)/poro/poro-server.conf ] || \
+		echo "uninstall: $(DESTDIR)$(SYSCONFDIR)/poro/poro-server.conf is left in place (configuration)"
 
 # Formats the lines changed since FORMAT_BASE (default HEAD: the uncommitted work) by .clang-format;
 # `make format FORMAT_BASE=origin/main` takes a whole branch. Needs Debian's clang-format.
