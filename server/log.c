@@ -26,7 +26,7 @@
 
 #define ELLIPSIS "..."
 
-static int journal;               /* stderr is the journal: "<N>" prefixes, no time */
+static int journal; /* stderr is the journal: "<N>" prefixes, no time */
 static int access_fd = -1;
 
 /* JOURNAL_STREAM is "DEVICE:INODE" of the stream systemd connected to stdout and stderr; it is
@@ -89,7 +89,11 @@ static int needs_quotes(const char *v)
 static size_t escape(unsigned char c, char *buf)
 {
 	switch (c) {
-	case '"': case '\\': buf[0] = '\\'; buf[1] = (char)c; return 2;
+	case '"':
+	case '\\':
+		buf[0] = '\\';
+		buf[1] = (char)c;
+		return 2;
 	case '\n': memcpy(buf, "\\n", 2); return 2;
 	case '\r': memcpy(buf, "\\r", 2); return 2;
 	case '\t': memcpy(buf, "\\t", 2); return 2;
@@ -137,7 +141,7 @@ void log_line_str(struct log_line *l, const char *key, const char *value)
 		put_raw(l, " ", 1);
 	put_raw(l, key, strlen(key));
 	put_raw(l, "=", 1);
-	if (l->full) {             /* not even the key fits: the field is left out */
+	if (l->full) { /* not even the key fits: the field is left out */
 		l->size = before;
 		return;
 	}

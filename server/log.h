@@ -40,10 +40,10 @@ enum log_priority {
 /* A line being built on the stack; nothing is allocated, so logging works when memory ran out. */
 struct log_line {
 	int priority;
-	int access;                   /* a request line: also to --access-log */
-	int full;                     /* a value was cut: add nothing more */
+	int access; /* a request line: also to --access-log */
+	int full;   /* a value was cut: add nothing more */
 	size_t size;
-	char text[LOG_LINE_MAX];      /* "level=... msg=... key=value ...", no newline */
+	char text[LOG_LINE_MAX]; /* "level=... msg=... key=value ...", no newline */
 };
 
 /* Reads JOURNAL_STREAM: called once, first thing, before any thread logs. Without it lines are

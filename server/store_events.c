@@ -30,11 +30,11 @@
 struct event_note {
 	long long job;
 	int attempt;
-	int has_from;                 /* 0 for the row of a submission (no state before) */
+	int has_from; /* 0 for the row of a submission (no state before) */
 	char from[STATE_NAME_MAX], to[STATE_NAME_MAX];
-	char worker[SERVER_NAME_MAX + 1];  /* "" when no worker held the job */
+	char worker[SERVER_NAME_MAX + 1]; /* "" when no worker held the job */
 	char actor[SERVER_NAME_MAX + 1];
-	char *detail;                 /* owned; NULL for none */
+	char *detail; /* owned; NULL for none */
 };
 
 static void copy_text(char *out, size_t size, sqlite3_value *v)

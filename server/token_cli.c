@@ -34,9 +34,10 @@ struct token_args {
 
 static int token_usage(void)
 {
-	fprintf(stderr, "usage: poro-server token create --state=DIR --user=NAME --role=user|worker|admin [--label=TEXT]\n"
-			"       poro-server token list --state=DIR\n"
-			"       poro-server token revoke --state=DIR --id=N\n");
+	fprintf(stderr,
+		"usage: poro-server token create --state=DIR --user=NAME --role=user|worker|admin [--label=TEXT]\n"
+		"       poro-server token list --state=DIR\n"
+		"       poro-server token revoke --state=DIR --id=N\n");
 	return 2;
 }
 
@@ -72,7 +73,8 @@ static int parse_token_args(int argc, char **argv, struct token_args *a)
 			fprintf(stderr, "poro-server: token %s: '%s' needs a value\n", argv[2], argv[2 + optind - 1]);
 			return -1;
 		default:
-			fprintf(stderr, "poro-server: token %s: unknown argument '%s'\n", argv[2], argv[2 + optind - 1]);
+			fprintf(stderr, "poro-server: token %s: unknown argument '%s'\n", argv[2],
+				argv[2 + optind - 1]);
 			return -1;
 		}
 	}

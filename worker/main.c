@@ -94,8 +94,21 @@ void worker_sleep(double seconds, int wake_on_drain)
 #define MEMORY_DEFAULT (-1L)     /* memory_limit_mb before the default is computed */
 
 /* The options, in the order --help lists them: getopt_long's table and the help text. */
-enum { OPT_SERVER = 256, OPT_TOKEN, OPT_TOKEN_FILE, OPT_SLOTS, OPT_THREADS, OPT_WORK, OPT_SOLVER, OPT_MEMORY,
-       OPT_CHECKPOINT_WALL, OPT_LEASE_RENEW, OPT_NAME, OPT_KEEP_WORK, OPT_VERSION };
+enum {
+	OPT_SERVER = 256,
+	OPT_TOKEN,
+	OPT_TOKEN_FILE,
+	OPT_SLOTS,
+	OPT_THREADS,
+	OPT_WORK,
+	OPT_SOLVER,
+	OPT_MEMORY,
+	OPT_CHECKPOINT_WALL,
+	OPT_LEASE_RENEW,
+	OPT_NAME,
+	OPT_KEEP_WORK,
+	OPT_VERSION
+};
 static const struct option OPTIONS[] = {
 	{ "server", required_argument, NULL, OPT_SERVER },
 	{ "token-file", required_argument, NULL, OPT_TOKEN_FILE },
@@ -305,61 +318,37 @@ static int parse_flags(int argc, char **argv)
 	while (rc == 0 && (opt = getopt_long(argc, argv, ":h", OPTIONS, &index)) != -1) {
 		const char *o = OPTIONS[index].name;
 		switch (opt) {
-		case OPT_SERVER:
-			snprintf(worker_opt.server, sizeof worker_opt.server, "%s", optarg);
-			break;
+		case OPT_SERVER: snprintf(worker_opt.server, sizeof worker_opt.server, "%s", optarg); break;
 		case OPT_TOKEN:
 			snprintf(worker_opt.token, sizeof worker_opt.token, "%s", optarg);
 			memset(optarg, 'x', strlen(optarg)); /* out of /proc/PID/cmdline from now on */
 			fprintf(stderr, "poro-worker: warning: --token shows the token to every user of this machine "
 					"in the process list; use --token-file FILE or PORO_TOKEN\n");
 			break;
-		case OPT_TOKEN_FILE:
-			token_file = optarg;
-			break;
+		case OPT_TOKEN_FILE: token_file = optarg; break;
 		case OPT_SLOTS:
 			if ((rc = int_option(o, optarg, 1, 1024, &v)) == 0)
 				worker_opt.slots = (int)v;
 			break;
-		case OPT_THREADS:
-			rc = int_option(o, optarg, 1, THREADS_MAX, &budget);
-			break;
-		case OPT_WORK:
-			work = optarg;
-			break;
-		case OPT_SOLVER:
-			solver = optarg;
-			break;
-		case OPT_MEMORY:
-			rc = int_option(o, optarg, 0, 1L << 30, &worker_opt.memory_limit_mb);
-			break;
-		case OPT_CHECKPOINT_WALL:
-			rc = int_option(o, optarg, 0, 1L << 30, &worker_opt.checkpoint_wall);
-			break;
+		case OPT_THREADS: rc = int_option(o, optarg, 1, THREADS_MAX, &budget); break;
+		case OPT_WORK: work = optarg; break;
+		case OPT_SOLVER: solver = optarg; break;
+		case OPT_MEMORY: rc = int_option(o, optarg, 0, 1L << 30, &worker_opt.memory_limit_mb); break;
+		case OPT_CHECKPOINT_WALL: rc = int_option(o, optarg, 0, 1L << 30, &worker_opt.checkpoint_wall); break;
 		case OPT_LEASE_RENEW:
 			if ((rc = int_option(o, optarg, 1, 86400, &v)) == 0)
 				worker_opt.lease_renew = (double)v;
 			break;
-		case OPT_NAME:
-			name = optarg;
-			break;
+		case OPT_NAME: name = optarg; break;
 		case OPT_KEEP_WORK:
 			if (strcmp(optarg, "yes") && strcmp(optarg, "no"))
 				rc = bad_usage("--keep-work must be yes or no, got '%s'", optarg);
 			worker_opt.keep_work = !strcmp(optarg, "yes");
 			break;
-		case 'h':
-			help();
-			exit(0);
-		case OPT_VERSION:
-			printf("poro-worker %s\n", PORO_VERSION);
-			exit(0);
-		case ':':
-			rc = bad_usage("option '%s' needs a value", argv[optind - 1]);
-			break;
-		default:
-			rc = bad_usage("unknown option '%s'", argv[optind - 1]);
-			break;
+		case 'h': help(); exit(0);
+		case OPT_VERSION: printf("poro-worker %s\n", PORO_VERSION); exit(0);
+		case ':': rc = bad_usage("option '%s' needs a value", argv[optind - 1]); break;
+		default: rc = bad_usage("unknown option '%s'", argv[optind - 1]); break;
 		}
 	}
 	if (rc)
