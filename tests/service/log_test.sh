@@ -162,6 +162,10 @@ svc_stop main
 check sigterm_exit_0 "$SVC_STATUS" "exit $SVC_STATUS"
 has_line "$err" level=notice msg="stopped on signal 15 (Terminated)"
 check stop_line_notice $? "$(tail -2 "$err")"
+# nothing here went wrong: no warning or error, libmicrohttpd's own messages included (they come
+# through the same gateway; one about the order of its options went to its own logger once)
+! grep -qE 'level=(warning|error)' "$err"
+check no_warning_in_a_clean_run $? "$(grep -m3 -E 'level=(warning|error)' "$err")"
 
 # JOURNAL_STREAM is "DEVICE:INODE" of stderr; the file exists before the server starts
 journal_start() { # NAME JOURNAL_STREAM-VALUE-OR-"self"
