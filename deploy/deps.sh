@@ -20,6 +20,9 @@ packages=(
   python3-paraview      # ParaView's own XDMF readers, which tests/cli/paraview_test.sh opens
                         # result.xdmf with (no display needed: readers only)
   curl procps           # the service tests speak HTTP with curl and find processes with pgrep
+  systemd               # systemd-analyze: tests/install/install_test.sh verifies the installed units
+                        # (no systemd needs to run for that)
+  man-db                # man -l: the same test renders the installed man pages
 )
 
 # The OpenAPI linter of make test (tools/openapi-lint, pinned in its package-lock.json) runs on
