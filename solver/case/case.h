@@ -26,7 +26,9 @@
  * Each sits orders of magnitude above the largest case in tests/cases/ and near or beyond what a
  * run could hold in memory, so it refuses only cases that could not run anyway. */
 #define CASE_NAME_MAX 64                 /* bytes of a name with its NUL: names are 1 to 63 characters */
-#define CASE_TITLE_MAX 255               /* bytes of the title */
+#define CASE_TITLE_MAX 255               /* characters (Unicode code points) of the title, as JSON
+					    Schema's maxLength counts them */
+#define CASE_TITLE_SIZE (4 * CASE_TITLE_MAX + 1) /* bytes that hold such a title in UTF-8, with its NUL */
 #define CASE_MATERIALS_MAX 1000
 #define CASE_BODIES_MAX 1000
 #define CASE_LOADS_MAX 1000
@@ -234,7 +236,7 @@ struct case_probe {
 };
 
 struct case_spec {
-	char title[CASE_TITLE_MAX + 1];
+	char title[CASE_TITLE_SIZE];      /* UTF-8, at most CASE_TITLE_MAX characters */
 	char warnings[CASE_WARNINGS_SIZE]; /* "" when none (CASE_WARNINGS_SIZE) */
 	struct case_formulation formulation;
 	struct case_grid grid;

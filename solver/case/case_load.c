@@ -83,7 +83,7 @@ static const char *const probe_field_names[] = { "pore_pressure", "stress_xx", "
 static const char *const component_names[] = { "x", "y", NULL };
 
 /* Keys allowed in each object. */
-static const char *const top_keys[] = { "schema", "title", "formulation", "grid", "materials", "bodies",
+static const char *const top_keys[] = { "$schema", "schema", "title", "formulation", "grid", "materials", "bodies",
 					"fluid", "gravity", "boundaries", "loads", "time", "output",
 					"probes", "checkpoint", NULL };
 static const char *const formulation_keys[] = { "scheme", "phases", "shape", "pore_pressure_smoothing",
@@ -159,15 +159,12 @@ static void check_unique(struct case_reader *r, struct case_names *names, const 
 static void read_header(struct case_reader *r, const json_t *root, struct case_spec *c)
 {
 	int version;
-	const char *title;
+	const char *schema_location;
+	/* "$schema" names the JSON Schema for editors (VS Code and others validate and complete
+	 * against it); the solver only checks that it is a string */
+	case_read_string(r, root, "", "$schema", CASE_OPTIONAL, &schema_location);
 	case_read_choice(r, root, "", "schema", CASE_REQUIRED, schema_names, &version);
-	if (!case_read_string(r, root, "", "title", CASE_OPTIONAL, &title))
-		return;
-	size_t length = strlen(title);
-	if (length > CASE_TITLE_MAX)
-		case_problem(r, "/title", "must be at most %d bytes long, got %zu", CASE_TITLE_MAX, length);
-	else
-		memcpy(c->title, title, length + 1);
+	case_read_short_text(r, root, "", "title", CASE_OPTIONAL, CASE_TITLE_MAX, c->title);
 }
 
 static void read_formulation(struct case_reader *r, const json_t *root, struct case_formulation *f)

@@ -506,7 +506,7 @@ static void test_out_of_range(void)
 		       "0123456789012345678901234567890123456789012345678901234567890123456789"
 		       "0123456789012345678901234567890123456789012345678901234567890123456789"
 		       "0123456789012345678901234567890123456789012345678901234567890123456789" "\"",
-		       "/title: must be at most 255 bytes long, got 280");
+		       "/title: must be at most 255 characters long, got 280");
 }
 
 static void test_unknown_keys(void)
@@ -522,6 +522,32 @@ static void test_unknown_keys(void)
 		       "/probes/0/component: unknown key");
 	expect_invalid("key escaped in the pointer", "/materials/0/a~b", "1",
 		       "/materials/0/a~0b: unknown key");
+}
+
+/* "$schema" names the JSON Schema for editors (case.schema.json, element.schema.json): any string, in a simulation
+ * case and in an element case alike; anything else is refused. It was an unknown key. */
+static void test_schema_location(void)
+{
+	static const char *element =
+		"{\"$schema\": \"../../schemas/element.schema.json\", \"schema\": \"poro-element/1\","
+		" \"material\": {\"model\": \"linear_elastic\", \"youngs_modulus\": 2.5e7, \"poisson_ratio\": 0.25},"
+		" \"test\": \"drained\", \"confining_pressure\": 1.25e5, \"axial_strain\": -0.0125, \"steps\": 10}";
+	const struct edit e = { "/$schema", "\"https://example.org/poro/case.schema.json\"" };
+	char *text = edited(minimal_case, &e, 1);
+	struct case_spec *c = load_valid("case with $schema loads", text);
+	case_destroy(&c);
+	free(text);
+	expect_invalid("$schema not a string", "/$schema", "3", "/$schema: expected a string, got number");
+	struct element_case ec;
+	struct poro_error err = { 0 };
+	enum poro_status st = element_case_load_string(element, &ec, &err);
+	CHECK(st == PORO_OK, "element case with $schema loads", "status %d: %s", st, err.message);
+	const struct edit bad = { "/$schema", "{}" };
+	text = edited(element, &bad, 1);
+	st = element_case_load_string(text, &ec, &err);
+	CHECK(st == PORO_EINVAL && strstr(err.message, "/$schema: expected a string, got object"),
+	      "element case with a $schema object refused", "status %d: %s", st, err.message);
+	free(text);
 }
 
 static void test_references_and_geometry(void)
@@ -801,6 +827,7 @@ int main(void)
 	test_wrong_types();
 	test_out_of_range();
 	test_unknown_keys();
+	test_schema_location();
 	test_references_and_geometry();
 	test_missing_required();
 	test_duplicates();
