@@ -37,6 +37,11 @@ void stable_dt_estimate(const struct case_spec *c, struct stable_dt *out);
  * estimated in stable_dt.c). */
 double stable_dt_modulus(const struct case_spec *c, int i);
 
+/* The mass per volume of body i whose weight its skeleton carries, kg/m^3: the buoyant
+ * (1 - n0)(rho_s - rho_w) of a saturated body, the dry (1 - n0) rho_s of a dry one
+ * ("saturated": false). */
+double stable_dt_effective_density(const struct case_spec *c, int i);
+
 /* The largest dt the loader accepts: STABLE_DT_MAX_FACTOR times out->cfl. */
 double stable_dt_max(const struct stable_dt *e);
 

@@ -194,6 +194,8 @@ struct case_body {
 	enum permeability_law permeability_law; /* "constant" (default), "kozeny_carman" (000 step 8g),
 						   "volume_ratio" (k = k0 V/V0) or "volume_ratio_squared"
 						   (k = k0 (V/V0)^2, Xie and Leo 2004) */
+	int saturated;                    /* 1 (default): the pores are full of water; 0: a dry body, whose
+					     points carry no water (sim.c, docs/numerics.md "Dry bodies") */
 };
 
 struct case_time_function {

@@ -96,7 +96,7 @@ static const char *const grid_keys[] = { "origin", "extent", "cell_size", NULL }
 /* A material's own keys; its model's keys are checked by case_read_material_model(). */
 static const char *const material_keys[] = { "name", "density", NULL };
 static const char *const body_keys[] = { "name", "material", "rectangle", "polygon", "particles_per_cell",
-					 "porosity", "hydraulic_conductivity", "permeability_law", NULL };
+					 "porosity", "hydraulic_conductivity", "permeability_law", "saturated", NULL };
 static const char *const fluid_keys[] = { "density", "bulk_modulus", "cavitation_pressure",
 					  "cavitated_bulk_modulus", NULL };
 static const char *const gravity_keys[] = { "acceleration", "ramp_time", "elastic_loading", "loading_conductivity",
@@ -316,6 +316,8 @@ static int read_body(struct case_reader *r, const json_t *o, const char *p, cons
 			 &b->hydraulic_conductivity);
 	b->permeability_law = read_choice_or(r, o, p, "permeability_law", CASE_OPTIONAL,
 					     permeability_law_names, b->permeability_law);
+	b->saturated = 1;
+	case_read_bool(r, o, p, "saturated", CASE_OPTIONAL, &b->saturated);
 	return seeded;
 }
 

@@ -148,8 +148,15 @@ class Schema:
         errors = sorted(v.iter_errors(document), key=lambda e: list(e.path))
         if not errors:
             return True, [], ""
+        pointers = []
+
+        def collect(errs):   # with the errors inside oneOf's alternatives, which name the place
+            for e in errs:
+                pointers.append(pointer_of(e.absolute_path))
+                collect(e.context or [])
+        collect(errors)
         e = errors[0]
-        return False, [pointer_of(e.path) for e in errors], pointer_of(e.path) + ": " + e.message[:200]
+        return False, pointers, pointer_of(e.path) + ": " + e.message[:200]
 
 
 def pointer_of(path):

@@ -52,7 +52,7 @@ static const char *full_case =
 	"   {\"name\": \"wedge\", \"material\": \"clay-2\","
 	"     \"polygon\": [[0.2, 0.3], [0.9, 0.3], [0.45, 0.65]],"
 	"     \"particles_per_cell\": 4, \"porosity\": 0.4125, \"hydraulic_conductivity\": 2.5e-7,"
-	"     \"permeability_law\": \"kozeny_carman\"}],"
+	"     \"permeability_law\": \"kozeny_carman\", \"saturated\": false}],"
 	" \"fluid\": {\"density\": 998.2, \"bulk_modulus\": 2.15e9},"
 	" \"gravity\": {\"acceleration\": [0.5, -9.75], \"ramp_time\": 0.2},"
 	" \"boundaries\": {\"left\": {\"soil\": \"slip\", \"water\": \"fixed\"},"
@@ -191,6 +191,7 @@ static void test_minimal_defaults(const struct case_spec *c)
 	CHECK(f->specific_volume == SPECIFIC_VOLUME_POINT, "default specific volume", "got %d", f->specific_volume);
 	CHECK(c->bodies[0].permeability_law == PERMEABILITY_CONSTANT, "default permeability law", "got %d",
 	      c->bodies[0].permeability_law);
+	CHECK(c->bodies[0].saturated == 1, "a body is saturated by default", "got %d", c->bodies[0].saturated);
 	CHECK(c->fluid.density == 1000 && c->fluid.bulk_modulus == 2.2e9, "default fluid",
 	      "density %g bulk modulus %g", c->fluid.density, c->fluid.bulk_modulus);
 	const double *g = c->gravity.acceleration;
@@ -230,6 +231,8 @@ static void test_full_bodies(const struct case_spec *c)
 	CHECK(w->is_polygon && w->polygon_count == 3 && w->material == 1 && w->polygon[2][0] == 0.45 &&
 	      w->polygon[2][1] == 0.65 && w->permeability_law == PERMEABILITY_KOZENY_CARMAN,
 	      "full polygon body", "polygon body differs");
+	CHECK(c->bodies[0].saturated && !w->saturated, "a dry body reads as such", "saturated %d and %d",
+	      c->bodies[0].saturated, w->saturated);
 	CHECK(w->min[0] == 0.2 && w->min[1] == 0.3 && w->max[0] == 0.9 && w->max[1] == 0.65,
 	      "polygon bounding box", "[%g, %g] to [%g, %g]", w->min[0], w->min[1], w->max[0], w->max[1]);
 }
@@ -337,6 +340,8 @@ static void test_wrong_types(void)
 		       "/gravity/acceleration: expected 2 numbers, got 3");
 	expect_invalid("string in a vector", "/grid/origin/1", "\"0\"",
 		       "/grid/origin/1: expected a number, got string");
+	expect_invalid("number for saturated", "/bodies/1/saturated", "0",
+		       "/bodies/1/saturated: expected a boolean, got number");
 	expect_invalid("fraction for an integer", "/bodies/0/particles_per_cell", "2.5",
 		       "/bodies/0/particles_per_cell: expected an integer, got 2.5");
 	expect_invalid("array item not an object", "/probes/1", "7",
