@@ -317,7 +317,15 @@ static int read_body(struct case_reader *r, const json_t *o, const char *p, cons
 	b->permeability_law = read_choice_or(r, o, p, "permeability_law", CASE_OPTIONAL,
 					     permeability_law_names, b->permeability_law);
 	b->saturated = 1;
-	case_read_bool(r, o, p, "saturated", CASE_OPTIONAL, &b->saturated);
+	if (case_read_bool(r, o, p, "saturated", CASE_OPTIONAL, &b->saturated) && !b->saturated &&
+	    c->formulation.pressure_projection != PROJECTION_LAPLACIAN) {
+		/* measured with the Laplacian only: the consistent projection's low-permeability options
+		 * diverged on a dry fill (docs/numerics.md, "Dry bodies") */
+		char pointer[CASE_POINTER_MAX];
+		case_pointer_key(pointer, p, "saturated");
+		case_problem(r, pointer, "false needs /formulation/pressure_projection \"laplacian\": a dry body's "
+			     "contact is verified with it alone");
+	}
 	return seeded;
 }
 

@@ -19,7 +19,9 @@ The case files are described twice: by schemas/case.schema.json and schemas/elem
     as a disagreement, whichever side is wrong. The candidates are grouped by the part of the case
     (formulation, grid, materials of each model, bodies, loads, ...) and the kind of mutation, and
     one candidate of each group is drawn with a fixed seed: a few dozen mutations, the same on
-    every run.
+    every run. Besides them, one mutation for each rule between keys that both state (RULES: a
+    dry body with the consistent projection, a plate with it, cavitation with the weak free
+    surface, ...), made by hand since a draw of single-key mutations rarely meets one.
 
 Each check prints "PASS name" or "FAIL name: why" (tests/run.sh counts them); a disagreement
 names the mutation, the file it came from and what each side said.
@@ -351,6 +353,61 @@ def candidates(file, document, schema):
     return out
 
 
+def set_at(path, value):
+    """An edit that sets the value at path (a list of keys), or removes it when value is REMOVE."""
+    def change(d):
+        for p in path[:-1]:
+            d = d[p]
+        if value is REMOVE:
+            d.pop(path[-1])
+        else:
+            d[path[-1]] = value
+    return change
+
+
+REMOVE = object()
+
+# The rules between keys that the schema states (its if/then and dependentRequired) and the solver
+# checks: (case file, what, edits, meant to be valid, the object a refusal names: the whole case
+# where the two sides may name different keys of the rule, e.g. the body or the formulation).
+RULES = [
+    ("dry_embankment.json", "a dry body with the consistent projection",
+     [set_at(["formulation", "pressure_projection"], "consistent")], False, []),
+    ("dry_embankment.json", "a dry body with the Laplacian named",
+     [set_at(["formulation", "pressure_projection"], "laplacian")], True, []),
+    ("mandel.json", "a plate with the consistent projection",
+     [set_at(["formulation", "pressure_projection"], "consistent")], False, []),
+    ("mandel.json", "a plate face without its plate object",
+     [set_at(["boundaries", "top", "plate"], REMOVE)], False, ["boundaries", "top"]),
+    ("mandel.json", "a fixed face beside the plate",
+     [set_at(["boundaries", "left", "soil"], "fixed")], False, ["boundaries"]),
+    ("cavitation_column.json", "cavitation with the weak free surface",
+     [set_at(["formulation", "pressure_projection"], "consistent"), set_at(["formulation", "free_surface"], "weak")],
+     False, []),
+    ("cavitation_column.json", "a cavitated bulk modulus without a cavitation pressure",
+     [set_at(["fluid", "cavitated_bulk_modulus"], 1.5e6), set_at(["fluid", "cavitation_pressure"], REMOVE)],
+     False, ["fluid"]),
+    ("landslide_dense_double_point.json", "the elastic loading without a gravity ramp",
+     [set_at(["gravity", "ramp_time"], REMOVE)], False, ["gravity"]),
+    ("terzaghi.json", "APIC with a FLIP fraction",
+     [set_at(["formulation", "velocity_update"], "apic"), set_at(["formulation", "flip_fraction"], 0.75)],
+     False, ["formulation"]),
+    ("terzaghi.json", "the second-difference stabilisation without the consistent projection",
+     [set_at(["formulation", "pressure_stabilisation"], "second_difference")], False, ["formulation"]),
+]
+
+
+def rule_mutations():
+    out = []
+    for file, what, edits, valid, path in RULES:
+        document = json.load(open(os.path.join(CASES, file)))
+        for edit in edits:
+            edit(document)
+        out.append(Mutation(("rules", what.replace(" ", "_")), "%s (%s)" % (what, pointer_of(path) or "/"),
+                            document, valid, file, path))
+    return out
+
+
 def solver_verdict(solve, path):
     """(accepted or None when it failed otherwise, [pointers of its problem lines], first line)."""
     r = subprocess.run([solve, "validate", path], capture_output=True, text=True)
@@ -400,6 +457,7 @@ def main():
     chosen = [rng.choice(groups[g]) for g in sorted(groups)]
     if "--all" in sys.argv:   # every candidate, not one a group: minutes, for changes to the schemas
         chosen = pool
+    chosen += rule_mutations()
     print("INFO schema_agreement: %d mutations drawn (seed %d), one from each of %d groups (part of the case, "
           "kind of mutation) of %d candidates from %d files" % (len(chosen), SEED, len(groups), len(pool), len(files)))
     judged_otherwise = 0

@@ -52,7 +52,7 @@ static const char *full_case =
 	"   {\"name\": \"wedge\", \"material\": \"clay-2\","
 	"     \"polygon\": [[0.2, 0.3], [0.9, 0.3], [0.45, 0.65]],"
 	"     \"particles_per_cell\": 4, \"porosity\": 0.4125, \"hydraulic_conductivity\": 2.5e-7,"
-	"     \"permeability_law\": \"kozeny_carman\", \"saturated\": false}],"
+	"     \"permeability_law\": \"kozeny_carman\"}],"
 	" \"fluid\": {\"density\": 998.2, \"bulk_modulus\": 2.15e9},"
 	" \"gravity\": {\"acceleration\": [0.5, -9.75], \"ramp_time\": 0.2},"
 	" \"boundaries\": {\"left\": {\"soil\": \"slip\", \"water\": \"fixed\"},"
@@ -231,8 +231,13 @@ static void test_full_bodies(const struct case_spec *c)
 	CHECK(w->is_polygon && w->polygon_count == 3 && w->material == 1 && w->polygon[2][0] == 0.45 &&
 	      w->polygon[2][1] == 0.65 && w->permeability_law == PERMEABILITY_KOZENY_CARMAN,
 	      "full polygon body", "polygon body differs");
-	CHECK(c->bodies[0].saturated && !w->saturated, "a dry body reads as such", "saturated %d and %d",
-	      c->bodies[0].saturated, w->saturated);
+	const struct edit dry = { "/bodies/1/saturated", "false" };
+	char *text = edited(full_case, &dry, 1);
+	struct case_spec *d = load_valid("case with a dry body loads", text);
+	CHECK(d && d->bodies[0].saturated && !d->bodies[1].saturated, "a dry body reads as such", "saturated %d and %d",
+	      d ? d->bodies[0].saturated : -1, d ? d->bodies[1].saturated : -1);
+	case_destroy(&d);
+	free(text);
 	CHECK(w->min[0] == 0.2 && w->min[1] == 0.3 && w->max[0] == 0.9 && w->max[1] == 0.65,
 	      "polygon bounding box", "[%g, %g] to [%g, %g]", w->min[0], w->min[1], w->max[0], w->max[1]);
 }
@@ -342,6 +347,13 @@ static void test_wrong_types(void)
 		       "/grid/origin/1: expected a number, got string");
 	expect_invalid("number for saturated", "/bodies/1/saturated", "0",
 		       "/bodies/1/saturated: expected a boolean, got number");
+	{
+		const struct edit e[] = { { "/bodies/1/saturated", "false" },
+					  { "/formulation/pressure_projection", "\"consistent\"" } };
+		const char *needles[] = { "/bodies/1/saturated: false needs /formulation/pressure_projection \"laplacian\"",
+					  NULL };
+		expect_invalid_edits("dry body with the consistent projection", full_case, e, 2, needles);
+	}
 	expect_invalid("fraction for an integer", "/bodies/0/particles_per_cell", "2.5",
 		       "/bodies/0/particles_per_cell: expected an integer, got 2.5");
 	expect_invalid("array item not an object", "/probes/1", "7",
