@@ -5,7 +5,9 @@
 # files (wrong type, out of range, unknown key, a key of another model or kind, a missing
 # required key, and valid variants: inclusive bounds, optional keys removed, "$schema", a title
 # of the most characters), one drawn with a fixed seed from each part of the case and kind of
-# mutation, get the same verdict from both, a refusal naming the mutated object on both sides.
+# mutation, get the same verdict from both, a refusal naming the mutated object on both sides; and
+# one hand-made mutation for each rule between keys that both state (a dry body with the
+# consistent projection, a plate without its plate object, ...).
 # tests/cli/schema_agreement.py does the work and says how the mutations are made; every
 # disagreement is a FAIL naming the mutation and the case it came from.
 # Debian's python3 with python3-jsonschema (deploy/deps.sh). Runs in about 10 s.
