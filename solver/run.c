@@ -42,8 +42,10 @@ static enum poro_status write_frame(struct sim *s, struct output *o)
 {
 	struct output_frame fr = {.time = s->time, .step = s->step, .soil = &s->soil,
 				  .water = s->double_point ? &s->water : NULL};
-	if (!s->double_point)    /* single point: the soil points carry the pore pressure */
-		memcpy(s->soil.pressure, s->water.pressure, sizeof(double) * (size_t)s->soil.n);
+	/* single point: the soil points carry the pore pressure; those of dry bodies, the last ones
+	 * (sim.c), carry no water and keep 0 */
+	if (!s->double_point)
+		memcpy(s->soil.pressure, s->water.pressure, sizeof(double) * (size_t)s->water.n);
 	return output_frame_write(o, &fr, &s->err);
 }
 

@@ -64,6 +64,11 @@ double stable_dt_modulus(const struct case_spec *c, int i);
  * larger root of the no-drag plane-wave problem of 002 Eqs. 9, 16-17 (spec-002 §5.1). */
 double stable_dt_fast_wave_speed(double M, double rho_s, double n, double rho_f, double K_f);
 
+/* The mass per volume of body i whose weight its skeleton carries, kg/m^3: the buoyant
+ * (1 - n0)(rho_s - rho_w) of a saturated body, the dry (1 - n0) rho_s of a dry one
+ * ("saturated": false). */
+double stable_dt_effective_density(const struct case_spec *c, int i);
+
 /* The largest dt the loader accepts, and the dt that "auto" takes. */
 double stable_dt_max(const struct stable_dt *e);
 double stable_dt_recommended(const struct stable_dt *e);

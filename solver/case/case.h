@@ -26,7 +26,9 @@
  * Each sits orders of magnitude above the largest case in tests/cases/ and near or beyond what a
  * run could hold in memory, so it refuses only cases that could not run anyway. */
 #define CASE_NAME_MAX 64                 /* bytes of a name with its NUL: names are 1 to 63 characters */
-#define CASE_TITLE_MAX 255               /* bytes of the title */
+#define CASE_TITLE_MAX 255               /* characters (Unicode code points) of the title, as JSON
+					    Schema's maxLength counts them */
+#define CASE_TITLE_SIZE (4 * CASE_TITLE_MAX + 1) /* bytes that hold such a title in UTF-8, with its NUL */
 #define CASE_MATERIALS_MAX 1000
 #define CASE_BODIES_MAX 1000
 #define CASE_LOADS_MAX 1000
@@ -211,6 +213,8 @@ struct case_body {
 						   (k = k0 (V/V0)^2, Xie and Leo 2004) */
 	double initial_pore_pressure;     /* Pa, compression positive, default 0: the points' pore
 					     pressure at t = 0 (002 §4.1 starts at p0 = q with sigma' = 0) */
+	int saturated;                    /* 1 (default): the pores are full of water; 0: a dry body, whose
+					     points carry no water (sim.c, docs/numerics.md "Dry bodies") */
 };
 
 struct case_time_function {
@@ -255,7 +259,7 @@ struct case_probe {
 };
 
 struct case_spec {
-	char title[CASE_TITLE_MAX + 1];
+	char title[CASE_TITLE_SIZE];      /* UTF-8, at most CASE_TITLE_MAX characters */
 	char warnings[CASE_WARNINGS_SIZE]; /* "" when none (CASE_WARNINGS_SIZE) */
 	struct case_formulation formulation;
 	struct case_grid grid;

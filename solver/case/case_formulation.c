@@ -170,6 +170,9 @@ void case_read_formulation(struct case_reader *r, const json_t *root, struct cas
 	if (scheme >= 0)
 		f->scheme = scheme;
 	check_formulation_keys(r, o, f->scheme);
+	/* Only paper 000's scheme has a double-point form: the others default to the one they take. */
+	if (f->scheme != SCHEME_SEMI_IMPLICIT)
+		f->phases = PHASES_SINGLE_POINT;
 	f->phases = choice_or(r, o, p, "phases", CASE_OPTIONAL, phases_names, f->phases);
 	f->shape = choice_or(r, o, p, "shape", CASE_OPTIONAL, shape_names, f->shape);
 	case_read_number(r, o, p, "flip_fraction", CASE_OPTIONAL, &FRACTION, &f->flip_fraction);

@@ -192,6 +192,7 @@ static void test_minimal_defaults(const struct case_spec *c)
 	CHECK(f->specific_volume == SPECIFIC_VOLUME_POINT, "default specific volume", "got %d", f->specific_volume);
 	CHECK(c->bodies[0].permeability_law == PERMEABILITY_CONSTANT, "default permeability law", "got %d",
 	      c->bodies[0].permeability_law);
+	CHECK(c->bodies[0].saturated == 1, "a body is saturated by default", "got %d", c->bodies[0].saturated);
 	CHECK(c->fluid.density == 1000 && c->fluid.bulk_modulus == 2.2e9, "default fluid",
 	      "density %g bulk modulus %g", c->fluid.density, c->fluid.bulk_modulus);
 	const double *g = c->gravity.acceleration;
@@ -231,6 +232,13 @@ static void test_full_bodies(const struct case_spec *c)
 	CHECK(w->is_polygon && w->polygon_count == 3 && w->material == 1 && w->polygon[2][0] == 0.45 &&
 	      w->polygon[2][1] == 0.65 && w->permeability_law == PERMEABILITY_KOZENY_CARMAN,
 	      "full polygon body", "polygon body differs");
+	const struct edit dry = { "/bodies/1/saturated", "false" };
+	char *text = edited(full_case, &dry, 1);
+	struct case_spec *d = load_valid("case with a dry body loads", text);
+	CHECK(d && d->bodies[0].saturated && !d->bodies[1].saturated, "a dry body reads as such", "saturated %d and %d",
+	      d ? d->bodies[0].saturated : -1, d ? d->bodies[1].saturated : -1);
+	case_destroy(&d);
+	free(text);
 	CHECK(w->min[0] == 0.2 && w->min[1] == 0.3 && w->max[0] == 0.9 && w->max[1] == 0.65,
 	      "polygon bounding box", "[%g, %g] to [%g, %g]", w->min[0], w->min[1], w->max[0], w->max[1]);
 }
@@ -338,6 +346,15 @@ static void test_wrong_types(void)
 		       "/gravity/acceleration: expected 2 numbers, got 3");
 	expect_invalid("string in a vector", "/grid/origin/1", "\"0\"",
 		       "/grid/origin/1: expected a number, got string");
+	expect_invalid("number for saturated", "/bodies/1/saturated", "0",
+		       "/bodies/1/saturated: expected a boolean, got number");
+	{
+		const struct edit e[] = { { "/bodies/1/saturated", "false" },
+					  { "/formulation/pressure_projection", "\"consistent\"" } };
+		const char *needles[] = { "/bodies/1/saturated: false needs /formulation/pressure_projection \"laplacian\"",
+					  NULL };
+		expect_invalid_edits("dry body with the consistent projection", full_case, e, 2, needles);
+	}
 	expect_invalid("fraction for an integer", "/bodies/0/particles_per_cell", "2.5",
 		       "/bodies/0/particles_per_cell: expected an integer, got 2.5");
 	expect_invalid("array item not an object", "/probes/1", "7",
@@ -507,7 +524,7 @@ static void test_out_of_range(void)
 		       "0123456789012345678901234567890123456789012345678901234567890123456789"
 		       "0123456789012345678901234567890123456789012345678901234567890123456789"
 		       "0123456789012345678901234567890123456789012345678901234567890123456789" "\"",
-		       "/title: must be at most 255 bytes long, got 280");
+		       "/title: must be at most 255 characters long, got 280");
 }
 
 static void test_unknown_keys(void)
@@ -523,6 +540,32 @@ static void test_unknown_keys(void)
 		       "/probes/0/component: unknown key");
 	expect_invalid("key escaped in the pointer", "/materials/0/a~b", "1",
 		       "/materials/0/a~0b: unknown key");
+}
+
+/* "$schema" names the JSON Schema for editors (case.schema.json, element.schema.json): any string, in a simulation
+ * case and in an element case alike; anything else is refused. It was an unknown key. */
+static void test_schema_location(void)
+{
+	static const char *element =
+		"{\"$schema\": \"../../schemas/element.schema.json\", \"schema\": \"poro-element/1\","
+		" \"material\": {\"model\": \"linear_elastic\", \"youngs_modulus\": 2.5e7, \"poisson_ratio\": 0.25},"
+		" \"test\": \"drained\", \"confining_pressure\": 1.25e5, \"axial_strain\": -0.0125, \"steps\": 10}";
+	const struct edit e = { "/$schema", "\"https://example.org/poro/case.schema.json\"" };
+	char *text = edited(minimal_case, &e, 1);
+	struct case_spec *c = load_valid("case with $schema loads", text);
+	case_destroy(&c);
+	free(text);
+	expect_invalid("$schema not a string", "/$schema", "3", "/$schema: expected a string, got number");
+	struct element_case ec;
+	struct poro_error err = { 0 };
+	enum poro_status st = element_case_load_string(element, &ec, &err);
+	CHECK(st == PORO_OK, "element case with $schema loads", "status %d: %s", st, err.message);
+	const struct edit bad = { "/$schema", "{}" };
+	text = edited(element, &bad, 1);
+	st = element_case_load_string(text, &ec, &err);
+	CHECK(st == PORO_EINVAL && strstr(err.message, "/$schema: expected a string, got object"),
+	      "element case with a $schema object refused", "status %d: %s", st, err.message);
+	free(text);
 }
 
 static void test_references_and_geometry(void)
@@ -870,6 +913,7 @@ int main(void)
 	test_wrong_types();
 	test_out_of_range();
 	test_unknown_keys();
+	test_schema_location();
 	test_references_and_geometry();
 	test_missing_required();
 	test_duplicates();

@@ -11,7 +11,10 @@
  * resume factorises afresh where the uninterrupted run uses conjugate gradients on its previous
  * factor (spd_solve.h), converged to a relative residual of 1e-12; the measured differences are
  * printed as INFO lines. Both double point and single point, each also with APIC point velocities
- * (whose affine velocities C the checkpoint must carry).
+ * (whose affine velocities C the checkpoint must carry), and the dry embankment of
+ * tests/cases/dry_embankment.json, whose dry fill's points carry no water: the single-point
+ * water set is then the clay's points only, which the resume must accept (it required one water
+ * value per soil point).
  *
  * The sim_run test kills a run in a child process (_exit, like kill -9) right after its first
  * checkpoint is announced, resumes it in the same directory, and requires result.h5 to hold the
@@ -23,6 +26,7 @@
 #include "checkpoint.h"
 
 #include <hdf5.h>
+#include <jansson.h>
 #include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -105,6 +109,21 @@ static char *case_json_with(const char *phases, const char *velocity_update, con
 static char *case_json(const char *phases, const char *extra)
 {
 	return case_json_with(phases, "flip", extra);
+}
+
+/* tests/cases/dry_embankment.json with phases, cut to the steps of a resume test; a heap string
+ * the caller frees, NULL if the file cannot be read. */
+static char *dry_embankment_json(const char *phases)
+{
+	json_t *c = json_load_file("tests/cases/dry_embankment.json", 0, NULL);
+	if (!c)
+		return NULL;
+	json_t *time = json_object_get(c, "time");
+	json_object_set_new(json_object_get(c, "formulation"), "phases", json_string(phases));
+	json_object_set_new(time, "end", json_real((STEPS_BEFORE + STEPS_AFTER) * json_real_value(json_object_get(time, "dt"))));
+	char *text = json_dumps(c, 0);
+	json_decref(c);
+	return text;
 }
 
 /* ---- fixtures ---------------------------------------------------------------------------------- */
@@ -544,6 +563,11 @@ int main(int argc, char **argv)
 	test_resume("single_point_aflip", "single_point", "aflip");
 	test_resume_case("double_point_plate", plate_case_json("double_point"));
 	test_resume_case("single_point_plate", plate_case_json("single_point"));
+	for (int single = 0; single < 2; single++) {
+		char *json = dry_embankment_json(single ? "single_point" : "double_point");
+		test_resume_case(single ? "single_point_dry_fill" : "double_point_dry_fill", json ? json : "{}");
+		free(json);
+	}
 	test_refusals();
 	test_run_killed_and_resumed("double_point");
 	test_run_killed_and_resumed("single_point");
