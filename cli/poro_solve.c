@@ -143,8 +143,11 @@ static void print_progress(const struct sim_progress *p, void *user)
 		fflush(stdout);
 		return;
 	}
-	printf("step %ld/%ld  t = %.6g s  wall = %.2f s  %.3f us per material-point step\n", p->step,
+	printf("step %ld/%ld  t = %.6g s  wall = %.2f s  %.3f us per material-point step", p->step,
 	       p->steps_total, p->time, p->wall_seconds, p->us_per_point_step);
+	if (p->iterations_mean > 0.0)   /* after the figures the worker reads (worker/log_pump.c) */
+		printf("  Newton iterations %d (mean %.2f)", p->iterations_last, p->iterations_mean);
+	printf("\n");
 	fflush(stdout);
 }
 

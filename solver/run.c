@@ -71,6 +71,10 @@ static void report(struct sim *s, sim_progress_fn progress, void *user, double t
 		.us_per_point_step = steps > 0 ? 1e6 * wall / ((double)steps * points) : 0.0,
 		.checkpoint = checkpoint,
 	};
+	long total;
+	int count;
+	if (sim_iterations(s, &pr.iterations_last, &total, NULL, &count))
+		pr.iterations_mean = steps > 0 ? (double)total / (double)s->step : 0.0;
 	progress(&pr, user);
 }
 

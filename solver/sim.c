@@ -349,6 +349,14 @@ const char *sim_phase_name_of(const struct sim *s, enum sim_phase phase)
 	return phase < PHASE_COUNT ? s->scheme->phase_names[phase] : NULL;
 }
 
+int sim_iterations(const struct sim *s, int *last, long *total, const double **energies, int *count)
+{
+	*last = 0, *total = 0, *count = 0;
+	if (energies)
+		*energies = NULL;
+	return s->scheme->iterations ? s->scheme->iterations(s, last, total, energies, count) : 0;
+}
+
 double sim_phase_seconds(const struct sim *s, enum sim_phase phase)
 {
 	return phase < PHASE_COUNT ? s->phase_seconds[phase] : 0.0;

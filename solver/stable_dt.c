@@ -99,6 +99,8 @@ void stable_dt_estimate(const struct case_spec *c, struct stable_dt *out)
 {
 	*out = (struct stable_dt){ .scheme = c->formulation.scheme, .cfl = INFINITY, .wave_step = INFINITY,
 				   .drag_step = INFINITY, .body = -1, .drag_body = -1 };
+	if (c->formulation.scheme == SCHEME_IMPLICIT_UPU)
+		return;   /* Newmark's average acceleration: stable at any step (stable_dt.h) */
 	for (int i = 0; i < c->body_count; i++) {
 		double drag_step = INFINITY;
 		const struct stable_dt e = c->formulation.scheme == SCHEME_EXPLICIT ? coupled_step(c, i, &drag_step)

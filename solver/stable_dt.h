@@ -14,6 +14,10 @@
  * d(v_s - v_f)/dt = -lambda (v_s - v_f) is stable for lambda dt < 2, lambda = c_d (1 / rhō_s +
  * 1 / rhō_f), c_d = n^2 rho_f g / k (Eq. 12). The implicit nodal drag (the default) has no such bound.
  *
+ * Implicit u-p-U (paper 001): Newmark's average acceleration (beta = 1/4, gamma = 1/2, or any pair
+ * the loader accepts) is unconditionally stable for linear problems: no bound (body -1), dt is the
+ * user's choice by accuracy, and "auto" is refused.
+ *
  * case_load.c refuses a case whose dt exceeds stable_dt_max, names the bound with
  * stable_dt_describe, and takes stable_dt_recommended for "dt": "auto"; sim.c keeps the estimate
  * to quote it when a step fails (step_health.c).

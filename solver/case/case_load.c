@@ -46,7 +46,7 @@
 
 /* Limits. */
 /* Cells per direction: room for the B-splines' edge treatment (shape.h) and the semi-implicit
- * scheme's pressure stencils; uGIMP's support fits in 2, which the explicit scheme takes (002
+ * scheme's pressure stencils; uGIMP's support fits in 2, which the explicit and implicit schemes take (002
  * §4.1's column is 2 cells wide). */
 #define GRID_CELLS_MIN 3
 #define GRID_CELLS_MIN_NARROW 2
@@ -81,7 +81,7 @@ static const char *const material_keys[] = { "name", "density", NULL };
 static const char *const body_keys[] = { "name", "material", "rectangle", "polygon", "particles_per_cell",
 					 "porosity", "hydraulic_conductivity", "permeability_law", "saturated",
 					 "initial_pore_pressure", NULL };
-static const char *const fluid_keys[] = { "density", "bulk_modulus", "cavitation_pressure",
+static const char *const fluid_keys[] = { "density", "bulk_modulus", "grain_bulk_modulus", "cavitation_pressure",
 					  "cavitated_bulk_modulus", NULL };
 static const char *const gravity_keys[] = { "acceleration", "ramp_time", "elastic_loading", "loading_conductivity",
 						"water_attached", NULL };
@@ -183,7 +183,7 @@ static int read_grid(struct case_reader *r, const json_t *root, const struct cas
 	int extent_ok = case_read_vec2(r, o, p, "extent", CASE_REQUIRED, &POSITIVE, g->extent);
 	int cell_size_ok = case_read_number(r, o, p, "cell_size", CASE_REQUIRED, &POSITIVE, &g->cell_size);
 	if (extent_ok && cell_size_ok) {
-		const int least = form->shape == SHAPE_GIMP && form->scheme == SCHEME_EXPLICIT ? GRID_CELLS_MIN_NARROW
+		const int least = form->shape == SHAPE_GIMP && form->scheme != SCHEME_SEMI_IMPLICIT ? GRID_CELLS_MIN_NARROW
 												: GRID_CELLS_MIN;
 		extent_ok &= check_cell_count(r, g, 0, least);
 		extent_ok &= check_cell_count(r, g, 1, least);
@@ -322,6 +322,7 @@ static void read_fluid(struct case_reader *r, const json_t *root, struct case_sp
 	case_check_keys(r, o, "/fluid", fluid_keys);
 	case_read_number(r, o, "/fluid", "density", CASE_OPTIONAL, &POSITIVE, &c->fluid.density);
 	case_read_number(r, o, "/fluid", "bulk_modulus", CASE_OPTIONAL, &POSITIVE, &c->fluid.bulk_modulus);
+	case_read_number(r, o, "/fluid", "grain_bulk_modulus", CASE_OPTIONAL, &POSITIVE, &c->fluid.grain_bulk_modulus);
 	case_read_number(r, o, "/fluid", "cavitation_pressure", CASE_OPTIONAL, &NEGATIVE,
 			 &c->fluid.cavitation_pressure);
 	case_read_number(r, o, "/fluid", "cavitated_bulk_modulus", CASE_OPTIONAL, &POSITIVE,
@@ -542,6 +543,11 @@ static int read_time(struct case_reader *r, const json_t *root, struct case_spec
 	int ok = case_read_number_or_word(r, o, "/time", "dt", CASE_REQUIRED, &POSITIVE, "auto", &c->time.dt,
 					  &c->time.dt_auto);
 	ok &= case_read_number(r, o, "/time", "end", CASE_REQUIRED, &POSITIVE, &c->time.end);
+	if (ok && c->time.dt_auto && c->formulation.scheme == SCHEME_IMPLICIT_UPU) {
+		case_problem(r, "/time/dt", "\"auto\" has no meaning for the \"implicit_upU\" scheme, stable at any "
+			     "step: choose dt by the accuracy wanted");
+		return 0;
+	}
 	if (ok && c->time.dt_auto) {
 		/* the scheme's recommended step, known once everything it follows from was read */
 		struct stable_dt e;

@@ -901,6 +901,89 @@ static void test_explicit_scheme(const char *root)
 	free(base);
 }
 
+/* The implicit u-p-U scheme's keys (case_formulation.c): each refused with its pointer, and a
+ * valid implicit case read with every key (cases/terzaghi_001.json). */
+static void test_implicit_scheme(const char *root)
+{
+	char path[512];
+	snprintf(path, sizeof path, "%stests/cases/terzaghi_001.json", root);
+	char *base = NULL;
+	struct poro_error err = {0};
+	if (case_read_text(path, &base, &err)) {
+		CHECK(0, "implicit case readable", "%s", err.message);
+		return;
+	}
+	const struct {
+		const char *name, *pointer, *value, *needle;
+	} bad[] = {
+		{"implicit scheme is single point", "/formulation/phases", "\"double_point\"",
+		 "/formulation/phases: the \"implicit_upU\" scheme is single point"},
+		{"explicit key under implicit", "/formulation/drag", "\"implicit\"",
+		 "/formulation/drag: applies to the \"explicit\" scheme only, not to \"implicit_upU\""},
+		{"APIC under implicit", "/formulation/velocity_update", "\"apic\"",
+		 "/formulation/velocity_update: the \"implicit_upU\" scheme moves its points' velocities by Newmark"},
+		{"PIC blend under implicit", "/formulation/flip_fraction", "0.5",
+		 "/formulation/flip_fraction: the \"implicit_upU\" scheme moves its points' velocities by Newmark"},
+		{"F-bar under implicit", "/formulation/soil_stabilisation", "\"fbar\"",
+		 "/formulation/soil_stabilisation: must be one of 'none', 'bbar'"},
+		{"Newmark beta below stability", "/formulation/newmark_beta", "0.2",
+		 "/formulation/newmark_beta: with newmark_gamma 0.5 must be at least 0.25"},
+		{"Newmark gamma above 1", "/formulation/newmark_gamma", "1.5", "/formulation/newmark_gamma: must be"},
+		{"tolerance of 1", "/formulation/newton_tolerance", "1", "/formulation/newton_tolerance: must be"},
+		{"no iterations", "/formulation/newton_max_iterations", "0", "/formulation/newton_max_iterations: must be"},
+		{"unknown recovery", "/formulation/pressure_recovery", "\"spr\"",
+		 "/formulation/pressure_recovery: must be one of 'mlsa_patch', 'mlsa_nodal', 'none'"},
+		{"unknown mass matrix", "/formulation/mass_matrix", "\"diagonal\"",
+		 "/formulation/mass_matrix: must be one of 'consistent', 'lumped'"},
+		{"auto dt under implicit", "/time/dt", "\"auto\"", "/time/dt: \"auto\" has no meaning for the \"implicit_upU\""},
+		{"B-bar without uGIMP", "/formulation/shape", "\"linear\"",
+		 "/formulation/soil_stabilisation: \"bbar\" samples uGIMP at the cell centres"},
+		{"grain bulk modulus not positive", "/fluid/grain_bulk_modulus", "0", "/fluid/grain_bulk_modulus: must be"},
+		{"consistent tangent on a finite-strain model", "/formulation/tangent", "\"consistent\"", NULL},
+	};
+	for (size_t i = 0; i < sizeof bad / sizeof *bad; i++) {
+		/* the last: a finite-strain material beside the consistent tangent */
+		struct edit e[2] = {{bad[i].pointer, bad[i].value},
+				    {"/materials/0", "{\"name\": \"soil\", \"model\": \"hencky\", \"density\": 2650, "
+				     "\"youngs_modulus\": 1e7, \"poisson_ratio\": 0.0}"}};
+		const char *needles[] = {bad[i].needle ? bad[i].needle
+						       : "/materials/0: material 'soil' is finite strain: /formulation/tangent",
+					 NULL};
+		expect_invalid_edits(bad[i].name, base, e, bad[i].needle ? 1 : 2, needles);
+	}
+	const struct edit semi[] = {{"/formulation", "{\"scheme\": \"semi_implicit\", \"newmark_beta\": 0.3}"}};
+	const char *semi_needle[] = {"/formulation/newmark_beta: applies to the \"implicit_upU\" scheme only", NULL};
+	expect_invalid_edits("implicit key under semi-implicit", base, semi, 1, semi_needle);
+	const struct edit grain[] = {{"/formulation", "{\"scheme\": \"semi_implicit\"}"},
+				     {"/fluid/grain_bulk_modulus", "1e10"}};
+	const char *grain_needle[] = {"/fluid/grain_bulk_modulus: applies to the \"implicit_upU\" scheme only", NULL};
+	expect_invalid_edits("grain bulk modulus under semi-implicit", base, grain, 2, grain_needle);
+	const struct edit all[] = {{"/formulation", "{\"scheme\": \"implicit_upU\", \"phases\": \"single_point\", "
+				    "\"shape\": \"gimp\", \"soil_stabilisation\": \"bbar\", \"newmark_beta\": 0.3025, "
+				    "\"newmark_gamma\": 0.6, \"tangent\": \"consistent\", \"newton_tolerance\": 1e-8, "
+				    "\"newton_max_iterations\": 20, \"pressure_recovery\": \"mlsa_nodal\", "
+				    "\"mass_matrix\": \"lumped\"}"}, {"/fluid/grain_bulk_modulus", "1e10"}};
+	char *text = edited(base, all, 2);
+	struct case_spec *c = load_valid("implicit case with every key", text);
+	const struct case_formulation *f = c ? &c->formulation : NULL;
+	CHECK(c && f->scheme == SCHEME_IMPLICIT_UPU && f->soil_stabilisation == STABILISATION_BBAR &&
+	      f->newmark_beta == 0.3025 && f->newmark_gamma == 0.6 && f->tangent == NEWTON_TANGENT_CONSISTENT &&
+	      f->newton_tolerance == 1e-8 && f->newton_max_iterations == 20 &&
+	      f->pressure_recovery == PRESSURE_RECOVERY_MLSA_NODAL && f->mass_matrix == MASS_MATRIX_LUMPED &&
+	      c->fluid.grain_bulk_modulus == 1e10, "implicit keys read", "case %p", (void *)c);
+	case_destroy(&c);
+	free(text);
+	/* without phases the scheme's single point is the default */
+	const struct edit bare[] = {{"/formulation", "{\"scheme\": \"implicit_upU\", \"shape\": \"gimp\"}"}};
+	text = edited(base, bare, 1);
+	c = load_valid("implicit case without phases", text);
+	CHECK(c && c->formulation.phases == PHASES_SINGLE_POINT && c->formulation.soil_stabilisation == STABILISATION_BBAR,
+	      "implicit defaults: single point, B-bar", "case %p", (void *)c);
+	case_destroy(&c);
+	free(text);
+	free(base);
+}
+
 int main(void)
 {
 	char root[256];
@@ -923,5 +1006,6 @@ int main(void)
 	test_documented_example(root);
 	test_stable_dt(root);
 	test_explicit_scheme(root);
+	test_implicit_scheme(root);
 	HARNESS_EXIT();
 }
