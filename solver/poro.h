@@ -78,6 +78,12 @@ double sim_phase_seconds(const struct sim *s, enum sim_phase phase);
 #define SIM_ITERATIONS_KEPT 64
 int sim_iterations(const struct sim *s, int *last, long *total, const double **energies, int *count);
 
+/* The sparse direct solver's work so far, for a scheme with one (the implicit u-p-U scheme's LU):
+ * symbolic analyses, numeric factorisations, solves and the nonzeros of the last factors. Returns
+ * 0 (and zeros) for the others. */
+int sim_linear_solver_counts(const struct sim *s, long *analyses, long *factorisations, long *solves,
+			     long *factor_nonzeros);
+
 /* Value of probe i of the case at the current state (units: Pa, m). */
 double sim_probe_value(const struct sim *s, int i);
 

@@ -357,6 +357,14 @@ int sim_iterations(const struct sim *s, int *last, long *total, const double **e
 	return s->scheme->iterations ? s->scheme->iterations(s, last, total, energies, count) : 0;
 }
 
+int sim_linear_solver_counts(const struct sim *s, long *analyses, long *factorisations, long *solves,
+			     long *factor_nonzeros)
+{
+	*analyses = *factorisations = *solves = *factor_nonzeros = 0;
+	return s->scheme->solver_counts ? s->scheme->solver_counts(s, analyses, factorisations, solves, factor_nonzeros)
+					: 0;
+}
+
 double sim_phase_seconds(const struct sim *s, enum sim_phase phase)
 {
 	return phase < PHASE_COUNT ? s->phase_seconds[phase] : 0.0;

@@ -41,6 +41,9 @@ struct scheme {
 	/* A scheme that iterates within a step reports its iterations (poro.h, sim_iterations);
 	 * NULL for one that does not. */
 	int (*iterations)(const struct sim *s, int *last, long *total, const double **energies, int *count);
+	/* A scheme with a sparse direct solver reports its work (poro.h, sim_linear_solver_counts). */
+	int (*solver_counts)(const struct sim *s, long *analyses, long *factorisations, long *solves,
+			     long *factor_nonzeros);
 };
 
 /* The scheme a case asks for. */

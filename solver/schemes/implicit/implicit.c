@@ -462,6 +462,13 @@ static int iterations(const struct sim *s, int *last, long *total, const double 
 	return 1;
 }
 
+static int solver_counts(const struct sim *s, long *analyses, long *factorisations, long *solves,
+			 long *factor_nonzeros)
+{
+	lu_solver_counts(implicit_of(s)->lu, analyses, factorisations, solves, factor_nonzeros);
+	return 1;
+}
+
 const struct scheme implicit_upU_scheme = {
 	.name = "implicit_upU",
 	.phase_names = { "shape functions, B-bar", "nodal kinematics, loads", NULL, "Newmark matrix",
@@ -470,4 +477,5 @@ const struct scheme implicit_upU_scheme = {
 	.destroy = destroy,
 	.step = implicit_step,
 	.iterations = iterations,
+	.solver_counts = solver_counts,
 };

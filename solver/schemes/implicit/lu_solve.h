@@ -29,9 +29,11 @@ enum poro_status lu_solver_create(struct lu_solver **s, idx_t n, const idx_t *co
  * UMFPACK fails, the message naming why; PORO_ENOMEM when it runs out of memory. */
 enum poro_status lu_solver_factorise(struct lu_solver *s, const double *values, struct poro_error *err);
 
-/* Solves A x = b with the last factorisation, with up to LU_REFINEMENT_STEPS steps of iterative
- * refinement. *backward_error gets UMFPACK's relative backward error of the answer (may be NULL). */
-#define LU_REFINEMENT_STEPS 2
+/* Solves A x = b with the last factorisation. No iterative refinement: the Newton loop that calls
+ * it recomputes the true residual after every correction, which is refinement already, and
+ * UMFPACK's two default steps tripled the cost of a solve (each a product with A and a solve with
+ * the factors). *backward_error gets UMFPACK's relative backward error of the answer (may be NULL). */
+#define LU_REFINEMENT_STEPS 0
 enum poro_status lu_solver_solve(struct lu_solver *s, const double *b, double *x, double *backward_error,
 				 struct poro_error *err);
 
