@@ -46,7 +46,7 @@ struct server_config {
 	int max_backoff_seconds;      /* cap of the retry backoff min(2^(attempt-1), cap) */
 	int group_commit_max;         /* most write requests in one transaction */
 	int max_job_threads;          /* most threads a job may ask for (1..256 on the wire) */
-	char access_log[SERVER_STATE_MAX]; /* one line per answered request, or "" for none */
+	char access_log[SERVER_STATE_MAX]; /* the log's request lines go here too, or "" for none */
 	long long max_log_bytes;      /* log text kept per attempt: its first and last half, bytes */
 	long long user_max_stored_bytes; /* default per-user cap on stored bytes; 0 = unlimited */
 	int min_free_mb;              /* /healthz is degraded below this much free space on the state file system, MiB */

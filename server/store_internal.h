@@ -46,6 +46,11 @@ struct store {
 	void *observe_cls;
 
 	struct list_stats list;               /* under lock: the cost of listings (store_job_list) */
+
+	/* events rows written by the running batch, logged once it commits (store_events.c);
+	 * the writer thread's alone */
+	struct event_note *notes;
+	int note_count, note_cap, notes_lost;
 };
 
 typedef enum api_code (*write_fn)(struct store *s, struct conn *c, void *arg, struct api_error *err);
@@ -68,6 +73,16 @@ enum api_code db_fail(struct conn *c, struct api_error *err, const char *what);
 /* Opens and configures a connection (WAL, synchronous=FULL, busy timeout). */
 int conn_open(struct conn *c, const char *path, int readonly, char *msg, size_t msg_size);
 void conn_close(struct conn *c);
+
+/* The log line of every events row (store_events.c). watch installs, on the writer's connection,
+ * the TEMP trigger that notes each row (0, or -1 with msg set); mark is taken before a write
+ * runs and rollback drops the notes after it when the write is rolled back; flush logs the
+ * batch's notes when it committed, drops them when not; release frees them (store_close). */
+int store_events_watch(struct store *s, char *msg, size_t msg_size);
+int store_events_mark(const struct store *s);
+void store_events_rollback(struct store *s, int mark);
+void store_events_flush(struct store *s, int committed);
+void store_events_release(struct store *s);
 
 /* Migrations (migrations.c): applies every migration newer than the database's version in one
  * transaction; refuses a database newer than the binary. */

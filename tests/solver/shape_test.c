@@ -132,6 +132,39 @@ static void check_kind(enum case_shape kind, double lambda, const char *label)
 	      weights_1d(kind, lambda, cells + 1e-9, cells, inv_h, &i0, w, dw) == -1, name, "a point outside was accepted");
 }
 
+/* uGIMP against brute force: the mean of the hat and of its gradient over the point's domain
+ * [xi - lambda, xi + lambda] clipped to the grid, by the midpoint rule on QUADRATURE_SAMPLES
+ * sub-intervals, at random points inside and next to the edges and random half widths. */
+#define QUADRATURE_SAMPLES 20000
+static void check_gimp_brute_force(void)
+{
+	const idx_t cells = 5;
+	const double inv_h = 1.0 / 0.0437;
+	double worst = 0, worst_grad = 0;
+	for (int k = 0; k < 400; k++) {
+		const double lambda = rnd(0.01, 0.5), xi = k % 2 ? rnd(0, 1) : rnd(0, (double)cells);
+		const double a = fmax(xi - lambda, 0), b = fmin(xi + lambda, (double)cells);
+		double w[SHAPE_SUPPORT_MAX], dw[SHAPE_SUPPORT_MAX];
+		idx_t i0;
+		shape_1d_gimp(xi, lambda, cells, inv_h, &i0, w, dw);
+		for (int n = 0; n < 3; n++) {
+			const double node = (double)(i0 + n);
+			double mean = 0, mean_grad = 0;
+			for (int j = 0; j < QUADRATURE_SAMPLES; j++) {
+				const double x = a + (j + 0.5) * (b - a) / QUADRATURE_SAMPLES, d = x - node;
+				mean += fmax(0, 1 - fabs(d)) / QUADRATURE_SAMPLES;
+				mean_grad += (fabs(d) < 1 ? (d < 0 ? 1.0 : -1.0) : 0.0) / QUADRATURE_SAMPLES;
+			}
+			worst = fmax(worst, fabs(w[n] - mean));
+			worst_grad = fmax(worst_grad, fabs(dw[n] / inv_h - mean_grad));
+		}
+	}
+	printf("INFO gimp against the midpoint rule (%d samples): weights %.2e, gradients h %.2e\n", QUADRATURE_SAMPLES,
+	       worst, worst_grad);
+	CHECK(worst < 1e-8 && worst_grad < 1e-3, "gimp_matches_brute_force_means", "weights %.3e gradients %.3e", worst,
+	      worst_grad);
+}
+
 /* uGIMP next to a wall: under a uniform stress sigma the nodal forces -sigma sum_p V_p dS_I/dx of
  * rows of points seeded h/2 apart from the wall (2 points per cell, half width h/4, the first
  * domain touching the wall) are -sigma on the wall node and 0 on every other node, so a wall
@@ -286,6 +319,7 @@ int main(void)
 	check_cubic_closed_form();
 	check_gimp_closed_form();
 	check_gimp_wall_row();
+	check_gimp_brute_force();
 	check_2d(SHAPE_LINEAR, "linear");
 	check_2d(SHAPE_QUADRATIC_BSPLINE, "quadratic_bspline");
 	check_2d(SHAPE_CUBIC_BSPLINE, "cubic_bspline");
