@@ -157,7 +157,8 @@ static void read_figure(struct reader *rd, struct suite_case *c, const char *kin
 		problem(rd, p, "only timing figures are judged against history; give an accuracy or count figure a band");
 	*wants_history |= !strcmp(check, "history");
 	json_array_append_new(c->figures, json_pack("{s:s, s:s, s:O?}", "kind", kind, "check", check, "band", band));
-	if (!(figure_where((enum figure_kind)k) & FIGURE_ALWAYS)) {   /* the case must ask for it */
+	if (!(figure_where((enum figure_kind)k) & (element ? FIGURE_ELEMENT_ALWAYS : FIGURE_SIM_ALWAYS))) {
+		/* the case must ask for it */
 		json_t *metrics = json_object_get(c->spec, "metrics");
 		if (!json_is_object(metrics))
 			json_object_set_new(c->spec, "metrics", metrics = json_object());

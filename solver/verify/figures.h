@@ -5,7 +5,7 @@
  * it measures; poro-solve writes them into the run's metrics.json and result.h5's /metrics group
  * (metrics.h; schemas/results.md), and the benchmark nightlies judge them (docs/benchmarks.md).
  *
- * Every simulation run reports the timing and count figures and max_displacement; every element
+ * Every simulation run reports the timing figures, its steps and max_displacement; every element
  * run the element figures marked "always". The others a case asks for by name in its optional
  * "metrics" object ({"terzaghi_rms": true}), because they assume a kind of problem: the loader
  * refuses a figure the case cannot yield (figure_check), naming why, before anything runs.
@@ -25,23 +25,28 @@
 
 enum figure_class { FIGURE_ACCURACY, FIGURE_TIMING, FIGURE_COUNT_CLASS };
 
-/* Where a figure comes from: simulation runs, element runs, and whether every such run reports it. */
-enum { FIGURE_SIM = 1, FIGURE_ELEMENT = 2, FIGURE_ALWAYS = 4 };
+/* Where a figure comes from: simulation runs and element runs may report it (FIGURE_SIM,
+ * FIGURE_ELEMENT), and every such run does without being asked (the _ALWAYS bits). A figure a kind
+ * of run reports only when asked needs its case's "metrics" object to name it. */
+enum { FIGURE_SIM = 1, FIGURE_ELEMENT = 2, FIGURE_SIM_ALWAYS = 4, FIGURE_ELEMENT_ALWAYS = 8 };
+#define FIGURE_EVERY_RUN (FIGURE_SIM | FIGURE_ELEMENT | FIGURE_SIM_ALWAYS | FIGURE_ELEMENT_ALWAYS)
+#define FIGURE_EVERY_SIM (FIGURE_SIM | FIGURE_SIM_ALWAYS)
+#define FIGURE_EVERY_ELEMENT (FIGURE_ELEMENT | FIGURE_ELEMENT_ALWAYS)
 
 /*      kind                            name                      unit  class               where */
 #define FIGURE_MAP(X)                                                                                          \
-	X(FIGURE_WALL_SECONDS,          "wall_seconds",           "s",  FIGURE_TIMING,      FIGURE_SIM | FIGURE_ELEMENT | FIGURE_ALWAYS) \
-	X(FIGURE_CPU_SECONDS,           "cpu_seconds",            "s",  FIGURE_TIMING,      FIGURE_SIM | FIGURE_ELEMENT | FIGURE_ALWAYS) \
-	X(FIGURE_US_PER_POINT_STEP,     "us_per_point_step",      "us", FIGURE_TIMING,      FIGURE_SIM | FIGURE_ALWAYS) \
-	X(FIGURE_CPU_US_PER_POINT_STEP, "cpu_us_per_point_step",  "us", FIGURE_TIMING,      FIGURE_SIM | FIGURE_ALWAYS) \
-	X(FIGURE_MEDIAN_STEP_CPU_US,    "median_cpu_us_per_point_step", "us", FIGURE_TIMING, FIGURE_SIM | FIGURE_ALWAYS) \
-	X(FIGURE_STEPS,                 "steps",                  "1",  FIGURE_COUNT_CLASS, FIGURE_SIM | FIGURE_ELEMENT | FIGURE_ALWAYS) \
-	X(FIGURE_MAX_DISPLACEMENT,      "max_displacement",       "m",  FIGURE_ACCURACY,    FIGURE_SIM | FIGURE_ALWAYS) \
+	X(FIGURE_WALL_SECONDS,          "wall_seconds",           "s",  FIGURE_TIMING,      FIGURE_EVERY_RUN) \
+	X(FIGURE_CPU_SECONDS,           "cpu_seconds",            "s",  FIGURE_TIMING,      FIGURE_EVERY_RUN) \
+	X(FIGURE_US_PER_POINT_STEP,     "us_per_point_step",      "us", FIGURE_TIMING,      FIGURE_EVERY_SIM) \
+	X(FIGURE_CPU_US_PER_POINT_STEP, "cpu_us_per_point_step",  "us", FIGURE_TIMING,      FIGURE_EVERY_SIM) \
+	X(FIGURE_MEDIAN_STEP_CPU_US,    "median_cpu_us_per_point_step", "us", FIGURE_TIMING, FIGURE_EVERY_SIM) \
+	X(FIGURE_STEPS,                 "steps",                  "1",  FIGURE_COUNT_CLASS, FIGURE_EVERY_RUN) \
+	X(FIGURE_MAX_DISPLACEMENT,      "max_displacement",       "m",  FIGURE_ACCURACY,    FIGURE_EVERY_SIM) \
 	X(FIGURE_TERZAGHI_RMS,          "terzaghi_rms",           "1",  FIGURE_ACCURACY,    FIGURE_SIM) \
 	X(FIGURE_XIE_LEO_SETTLEMENT,    "xie_leo_settlement",     "1",  FIGURE_ACCURACY,    FIGURE_SIM) \
 	X(FIGURE_RUNOUT,                "runout",                 "m",  FIGURE_ACCURACY,    FIGURE_SIM) \
-	X(FIGURE_PEAK_Q,                "peak_q",                 "Pa", FIGURE_ACCURACY,    FIGURE_ELEMENT | FIGURE_ALWAYS) \
-	X(FIGURE_NEWTON_ITERATIONS,     "newton_iterations",      "1",  FIGURE_COUNT_CLASS, FIGURE_ELEMENT | FIGURE_ALWAYS) \
+	X(FIGURE_PEAK_Q,                "peak_q",                 "Pa", FIGURE_ACCURACY,    FIGURE_EVERY_ELEMENT) \
+	X(FIGURE_NEWTON_ITERATIONS,     "newton_iterations",      "1",  FIGURE_COUNT_CLASS, FIGURE_EVERY_ELEMENT | FIGURE_SIM) \
 	X(FIGURE_MOHR_COULOMB_PEAK,     "mohr_coulomb_peak_error", "1", FIGURE_ACCURACY,    FIGURE_ELEMENT)
 
 /* What each figure is, for docs and reports (figures.c holds the sentences):
@@ -62,7 +67,9 @@ enum { FIGURE_SIM = 1, FIGURE_ELEMENT = 2, FIGURE_ALWAYS = 4 };
  *                         87; the same column, Poisson ratio 0)
  *   runout                how far the slope's soil travelled by the last frame (report.h), m
  *   peak_q                largest deviator q of the element test, Pa
- *   newton_iterations     Newton iterations the drained element test took, all steps (0 undrained)
+ *   newton_iterations     Newton iterations of all steps: of the drained element test (0
+ *                         undrained), or, asked for, of a simulation by a scheme that iterates
+ *                         within a step (implicit_upU: sim_iterations)
  *   mohr_coulomb_peak_error  |q_peak - q_closed form| / q_closed form of a drained Mohr-Coulomb
  *                         element test (analytic.h), q taken at the last step */
 

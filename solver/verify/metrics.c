@@ -85,6 +85,13 @@ void metrics_of_run(struct metrics *m, const struct sim *s, const struct case_sp
 	metrics_set(m, FIGURE_CPU_US_PER_POINT_STEP, point_steps > 0 ? 1e6 * t.cpu_seconds / point_steps : NAN);
 	metrics_set(m, FIGURE_MEDIAN_STEP_CPU_US, t.points > 0 ? 1e6 * t.median_step_cpu / (double)t.points : NAN);
 	metrics_set(m, FIGURE_STEPS, (double)sim_steps_taken(s));
+	if (c->metrics & 1u << FIGURE_NEWTON_ITERATIONS) {
+		/* a count of the steps taken, so a failed run reports it too */
+		int last, kept;
+		long total = 0;
+		sim_iterations(s, &last, &total, NULL, &kept);
+		metrics_set(m, FIGURE_NEWTON_ITERATIONS, (double)total);
+	}
 	if (error)
 		return;   /* the state a failure left says nothing about accuracy */
 	metrics_set(m, FIGURE_MAX_DISPLACEMENT, figure_max_displacement(sim_soil(s)));

@@ -8,8 +8,10 @@
 # result.h5 whose probes are an empty set; a run that fails in a step still writes metrics.json,
 # with status "failed" and its error; the test knob PORO_DEBUG_SLOWDOWN leaves every frame
 # bit-identical (h5diff; the processor time it adds is printed, never asserted) and a bad value is
-# refused; a figure a case cannot yield, or an unknown one, is refused by validate naming
-# /metrics/NAME. The JSON documents are checked against schemas/metrics.schema.json (Debian's
+# refused; an implicit run asked for its Newton iterations reports the total its progress line
+# gives as a mean; a figure a case cannot yield (Newton iterations of a scheme that does not
+# iterate, Xie-Leo's settlement of a Hencky column), or an unknown one, is refused by validate
+# naming /metrics/NAME. The JSON documents are checked against schemas/metrics.schema.json (Debian's
 # python3-jsonschema; h5py is Debian's too, so /usr/bin/python3 runs these checks). Prints
 # "PASS name" / "FAIL name: why".
 #   bash tests/cli/metrics_test.sh BUILD_DIR      (from the repository root)
@@ -115,7 +117,35 @@ assert "wall_seconds" in m["figures"] and "max_displacement" not in m["figures"]
 PY
 check failed_run_writes_failed_metrics $(( rc != 3 || $? != 0 )) "exit $rc (want 3): $(tail -2 "$tmp/py") $(head -c 200 "$tmp/err")"
 
+# the implicit scheme's Newton iterations: asked for, the run's total, which poro-solve's progress
+# line states as its mean a step; on this yielding footing with the consistent tangent, more than
+# one a step (consolidation_001_test e holds the iterations to Newton's quadratic rate)
+derive_case footing tests/cases/strip_footing_001.json 'c["grid"]["cell_size"] = 0.5
+c["formulation"]["tangent"] = "consistent"
+c["loads"][0]["traction"] = [0.0, -600.0]; c["loads"][0]["time_function"]["ramp_time"] = 1.0
+c["time"]["end"] = 0.5; c["output"]["frame_interval"] = 0; c["metrics"] = {"newton_iterations": True}'
+"$solve" run "$tmp/footing.json" --out "$tmp/footing" > "$tmp/footing.out" 2> "$tmp/err"
+rc=$?
+"$PY3" - "$tmp/footing/metrics.json" "$tmp/footing.out" schemas/metrics.schema.json <<'PY' > "$tmp/py" 2>&1
+import json, re, sys, jsonschema
+m = json.load(open(sys.argv[1]))
+jsonschema.validate(m, json.load(open(sys.argv[3])))
+f = m["figures"]
+n, steps = f["newton_iterations"]["value"], f["steps"]["value"]
+assert f["newton_iterations"]["class"] == "count" and steps == 10, (f["newton_iterations"], steps)
+assert float(n).is_integer() and steps < n <= 100 * steps, (n, steps)
+means = re.findall(r"Newton iterations \d+ \(mean ([0-9.]+)\)", open(sys.argv[2]).read())
+assert means and abs(float(means[-1]) - n / steps) < 0.006, (means[-1:], n / steps)
+print("INFO footing 001, consistent tangent: %d Newton iterations in %d steps" % (n, steps))
+PY
+check implicit_run_reports_its_newton_iterations $(( rc != 0 || $? != 0 )) "exit $rc: $(tail -3 "$tmp/py") $(head -c 200 "$tmp/err")"
+grep '^INFO' "$tmp/py"
+
 # figures a case cannot yield, or does not know
+derive_case semi_newton tests/cases/terzaghi.json 'c["metrics"] = {"newton_iterations": True}'
+expect_invalid semi_newton /metrics/newton_iterations
+derive_case hencky_xie_leo tests/cases/xie_leo_hencky.json 'c["metrics"] = {"xie_leo_settlement": True}'
+expect_invalid hencky_xie_leo /metrics/xie_leo_settlement
 derive_case slope_terzaghi tests/cases/mc_slope_k1e-3_single_point.json 'c["metrics"] = {"terzaghi_rms": True}'
 expect_invalid slope_terzaghi /metrics/terzaghi_rms
 derive_case column_runout tests/cases/terzaghi.json 'c["metrics"] = {"runout": True}'

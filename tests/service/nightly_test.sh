@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
 # nightly_test.sh - benchmark nightlies through real processes (docs/benchmarks.md): a real
 # poro-server and real poro-workers on 127.0.0.1, `poro nightly` on the reduced suite
-# tests/service/nightly/suite.json (a short Terzaghi column, a Mohr-Coulomb element test, and a
-# short column timed in 5 repeats). What it shows, in the order of docs/benchmarks.md "Tests":
+# tests/service/nightly/suite.json (a short Terzaghi column by the semi-implicit and by the implicit
+# scheme, a Mohr-Coulomb element test, and a short column timed in 5 repeats). What it shows, in the order of docs/benchmarks.md "Tests":
 #   a. the suite run twice: two stored runs, each with its machine and fingerprint and every
 #      figure with its samples; `poro nightly compare` puts them side by side; every job carries
 #      the run's label; on a worker with two slots an exclusive (timing) job never ran beside
@@ -93,11 +93,14 @@ for path in sys.argv[1:]:
     for k in ("cpu_model", "cores", "memory_mb", "kernel", "compiler", "blas"):
         assert m.get(k), "machine has no " + k
     figs = {f["figure"]: f for f in run["figures"]}
-    assert len(figs) == 11, sorted(figs)
+    assert len(figs) == 14, sorted(figs)
     assert len(figs["speed/median_cpu_us_per_point_step"]["samples"]) == 5, figs["speed/median_cpu_us_per_point_step"]
     assert figs["speed/median_cpu_us_per_point_step"]["machine"] == run["fingerprint"]
     assert len(figs["terzaghi/terzaghi_rms"]["samples"]) == 1 and figs["terzaghi/terzaghi_rms"]["status"] == "ok"
     assert figs["mohr_coulomb/mohr_coulomb_peak_error"]["median"] < 1e-6
+    newton = figs["implicit/newton_iterations"]
+    assert newton["status"] == "ok" and newton["samples"] == [20], newton   # one a step: linear, elastic tangent
+    assert figs["implicit/terzaghi_rms"]["status"] == "ok", figs["implicit/terzaghi_rms"]
     assert all(f["status"] in ("ok", "recorded", "no_history") for f in run["figures"]), \
         [(f["figure"], f["status"]) for f in run["figures"]]
     assert run["commit"] and run["label"].startswith("reduced-") and run["solver_version"]
@@ -236,7 +239,7 @@ assert b["reduced.terzaghi.steps"] == "passed", b
 s = kinds(sys.argv[2])
 assert s["reduced.speed.median_cpu_us_per_point_step"] == "Failure", s
 a = kinds(sys.argv[3])
-assert len(a) == 11 and set(a.values()) == {"passed"}, a
+assert len(a) == 14 and set(a.values()) == {"passed"}, a
 print("ok")
 PY
 check c_junit_read_by_junitparser $? "$(tail -4 "$SVC_TMP/py")"
@@ -269,7 +272,8 @@ echo "INFO chromium screenshot $build/nightly-report.png: $(tail -1 "$SVC_TMP/py
 
 # ---- d. another machine fingerprint -------------------------------------------------------------------
 stop_worker "$wA"
-if [ "$(nproc)" -ge 2 ]; then
+# nproc counts OMP_NUM_THREADS as the processors available: the processors are what is asked
+if [ "$(env -u OMP_NUM_THREADS -u OMP_THREAD_LIMIT nproc)" -ge 2 ]; then
 	start_worker wOne 1 taskset -c 0
 	wOne=$worker_pid
 	nightly one run "$suite" --only speed
@@ -411,6 +415,25 @@ for f in "$SVC_TMP"/plan/*.json; do
 done
 check nightly_suite_cases_all_valid $(( rc != 0 || ok || n < 20 )) "exit $rc, $n cases: $(head -5 "$SVC_TMP/check.err")"
 echo "INFO bench/suite.json: $n cases, $(grep -c exclusive "$SVC_TMP/check.out") timed against history"
+# the nightly covers every case of tests/cases/ (each verification case of the three schemes and
+# each element test), so a case added there without a place in the suite shows here
+python3 - bench/suite.json tests/cases <<'PY' > "$SVC_TMP/py" 2>&1
+import glob, json, os, sys
+suite = json.load(open(sys.argv[1]))
+named = {os.path.normpath(os.path.join(os.path.dirname(sys.argv[1]), c["case"])) for c in suite["cases"]}
+files = sorted(glob.glob(os.path.join(sys.argv[2], "*.json")))
+missing = [f for f in files if os.path.normpath(f) not in named]
+assert not missing, "not in the suite: " + " ".join(missing)
+schemes = set()
+for f in files:
+    case = json.load(open(f))
+    if case.get("schema") == "poro-case/1":
+        schemes.add(case.get("formulation", {}).get("scheme", "semi_implicit"))
+assert schemes == {"semi_implicit", "explicit", "implicit_upU"}, schemes
+print("%d case files, schemes %s" % (len(files), " ".join(sorted(schemes))))
+PY
+check nightly_suite_covers_every_case_file $? "$(tail -2 "$SVC_TMP/py")"
+echo "INFO bench/suite.json covers $(tail -1 "$SVC_TMP/py")"
 
 # the CLI: a bad suite is refused before anything is sent, every problem named
 cp tests/cases/terzaghi.json "$SVC_TMP/terzaghi.json"
