@@ -6,6 +6,10 @@
  * x, beating all n y's, or a y, beating none), f(0, n, 0) = f(m, 0, 0) = 1. The table f(., n, .)
  * is built for n = 0, 1, ..., n_y in place, one row per m <= n_x; the counts are doubles, which
  * hold C(m + n, m) with 15 significant digits (p-values relative to 1e-15).
+ *
+ * With ties the exact distribution is the rank sum's over every choice of which n_x of the pooled
+ * values are x, each value keeping its mid-rank (exact_tied_tails; doubled, the ranks are
+ * integers).
  */
 #include "mann_whitney.h"
 
@@ -41,6 +45,21 @@ double mw_median(const double *v, int n)
 	return m;
 }
 
+/* The two tails P(X >= obs), P(X <= obs) of counts dist[0..max] of the values 0..max. */
+static void tails(const double *dist, long max, long obs, double *upper, double *lower)
+{
+	double total = 0, up = 0, low = 0;
+	for (long v = 0; v <= max; v++) {
+		total += dist[v];
+		if (v >= obs)
+			up += dist[v];
+		if (v <= obs)
+			low += dist[v];
+	}
+	*upper = up / total;
+	*lower = low / total;
+}
+
 /* P(U >= u) and P(U <= u) from the exact distribution for sizes m, n (no ties). u is a whole
  * number here. -1 without memory. */
 static int exact_tails(int m, int n, double u, double *upper, double *lower)
@@ -60,19 +79,34 @@ static int exact_tails(int m, int n, double u, double *upper, double *lower)
 			for (int v = umax; v >= j; v--)
 				row[v] += prev[v - j];
 		}
-	const double *dist = f + (size_t)m * (size_t)(umax + 1);
-	double total = 0, up = 0, low = 0;
-	int uo = (int)lround(u);
-	for (int v = 0; v <= umax; v++) {
-		total += dist[v];
-		if (v >= uo)
-			up += dist[v];
-		if (v <= uo)
-			low += dist[v];
-	}
+	tails(f + (size_t)m * (size_t)(umax + 1), umax, lround(u), upper, lower);
 	free(f);
-	*upper = up / total;
-	*lower = low / total;
+	return 0;
+}
+
+/* P(W >= w) and P(W <= w) for W the sum of nx of the N doubled mid-ranks w2[] chosen at random:
+ * the permutation distribution of the rank sum given the ties (each of the C(N, nx) choices
+ * equally likely). g[k][s] counts the choices of k of the items seen so far with sum s, items
+ * added one at a time with k descending (each item is chosen at most once). Sums of counts only,
+ * as above. -1 without memory. */
+static int exact_tied_tails(const int *w2, int N, int nx, long w_obs, double *upper, double *lower)
+{
+	long smax = 0;
+	for (int i = N - nx; i < N; i++)   /* w2 ascends: the largest nx */
+		smax += w2[i];
+	size_t width = (size_t)smax + 1;
+	double *g = calloc((size_t)(nx + 1) * width, sizeof *g);
+	if (!g)
+		return -1;
+	g[0] = 1;
+	for (int i = 0; i < N; i++)
+		for (int k = nx < i + 1 ? nx : i + 1; k >= 1; k--) {
+			double *row = g + (size_t)k * width, *prev = row - width;
+			for (long v = smax; v >= w2[i]; v--)
+				row[v] += prev[v - w2[i]];
+		}
+	tails(g + (size_t)nx * width, smax, w_obs, upper, lower);
+	free(g);
 	return 0;
 }
 
@@ -96,7 +130,13 @@ int mann_whitney(const double *x, int nx, const double *y, int ny, enum mw_alter
 	for (int j = 0; j < ny; j++)
 		r[nx + j] = (struct ranked){ y[j], 0 };
 	qsort(r, (size_t)N, sizeof *r, by_value);
+	int *w2 = malloc(sizeof *w2 * (size_t)N);   /* doubled mid-ranks, ascending */
+	if (!w2) {
+		free(r);
+		return -1;
+	}
 	double rank_x = 0, tie_sum = 0;
+	long w2_x = 0;
 	int ties = 0;
 	for (int i = 0; i < N;) {
 		int j = i;
@@ -108,23 +148,32 @@ int mann_whitney(const double *x, int nx, const double *y, int ny, enum mw_alter
 			ties = 1;
 			tie_sum += t * t * t - t;
 		}
-		for (int k = i; k <= j; k++)
+		for (int k = i; k <= j; k++) {
+			w2[k] = (i + 1) + (j + 1);
 			if (r[k].from_x)
-				rank_x += mid;
+				rank_x += mid, w2_x += w2[k];
+		}
 		i = j + 1;
 	}
 	free(r);
 	double u = rank_x - 0.5 * nx * (nx + 1.0);
 	double upper, lower;
 	out->u = u;
-	int exact_possible = !ties && (long)nx * ny <= MW_EXACT_MAX_PRODUCT;
-	if (method == MW_EXACT && !exact_possible)
+	/* the tied count's work: N items times nx rows times the sums (at most 2 N nx) */
+	int exact_possible = ties ? (double)N * nx * 2.0 * N * nx <= MW_EXACT_TIES_MAX_WORK
+				  : (long)nx * ny <= MW_EXACT_MAX_PRODUCT;
+	if (method == MW_EXACT && !exact_possible) {
+		free(w2);
 		return -1;
+	}
 	out->exact = method == MW_EXACT || (method == MW_AUTO && exact_possible);
-	if (out->exact) {
-		if (exact_tails(nx, ny, u, &upper, &lower))
-			return -1;
-	} else {
+	int rc = 0;
+	if (out->exact)
+		rc = ties ? exact_tied_tails(w2, N, nx, w2_x, &upper, &lower) : exact_tails(nx, ny, u, &upper, &lower);
+	free(w2);
+	if (rc)
+		return -1;
+	if (!out->exact) {
 		double mu = 0.5 * nx * ny;
 		double var = nx * (double)ny / 12.0 * ((N + 1.0) - tie_sum / ((double)N * (N - 1.0)));
 		double sd = var > 0 ? sqrt(var) : 0;

@@ -169,7 +169,13 @@ nightly slow run "$suite" --only speed --junit "$SVC_TMP/slow.xml"
 slow=$(last_run_id slow)
 grep -q '^speed/median_cpu_us_per_point_step .* regressed$' "$SVC_TMP/slow.out"
 check b_slowdown_1_5_flagged $(( rc != 9 || $? != 0 )) "exit $rc: $(cat "$SVC_TMP/slow.out" | head -12)"
-echo "INFO slowdown 1.5x: $(grep '^  speed/median_cpu_us_per_point_step' "$SVC_TMP/slow.out" | sed 's/^ *//')"
+# the verdict's detail and the samples, whatever the verdict, and each earlier run of the series
+# (its median and range): what to read when this check fails
+run_json "$slow"
+fp=$(python3 -c "import json,sys; print(json.load(open(sys.argv[1]))['fingerprint'])" "$SVC_TMP/run-$slow.json")
+svc_req GET "/v1/benchmarks/series?suite=reduced&figure=speed/median_cpu_us_per_point_step&machine=$fp" "$user" > /dev/null
+python3 -c "import json,sys; print('INFO series before the slowdown (run: median [min, max]): ' + ', '.join('%d: %.4g [%.4g, %.4g]' % (p['run'], p['median'], min(p['samples']), max(p['samples'])) for p in json.load(open(sys.argv[1]))['points'][:-1]))" "$SVC_BODY"
+python3 -c "import json,sys; f=[f for f in json.load(open(sys.argv[1]))['figures'] if f['figure']=='speed/median_cpu_us_per_point_step'][0]; print('INFO slowdown 1.5x: %s: %s; samples %s' % (f['status'], f['detail'], f['samples']))" "$SVC_TMP/run-$slow.json"
 stop_worker "$wSlow"
 
 start_worker wA 2
