@@ -138,7 +138,9 @@ void files_upload_begin(struct request *r)
 	}
 	char dir[SERVER_PATH_MAX], token[DIGEST_TOKEN_SIZE];
 	snprintf(dir, sizeof dir, "%s/files/%lld/%d", r->srv->cfg.state, r->id, u->attempt);
-	if (fs_make_dirs(dir) != 0 || digest_new_token(token) != 0) {
+	/* files/JOB and files/JOB/ATTEMPT must be durable before an index row names a file in them
+	 * (tests/fault/power_loss_test.sh lost every upload of a power cut without this) */
+	if (fs_make_dirs(dir) != 0 || fs_sync_parents(dir, 2) != 0 || digest_new_token(token) != 0) {
 		reply_fail(r, API_INTERNAL, "", "cannot create '%s': %s", dir, strerror(errno));
 		return;
 	}
