@@ -11,7 +11,7 @@
  *
  * OP is `write` (write, pwrite, pwrite64, writev, pwritev, fallocate) or `fsync` (fsync,
  * fdatasync); ERRNO one of EIO, ENOSPC, EDQUOT, EFBIG; MATCH a substring of the file's path
- * relative to the root, or `*` for every file under it; COUNT, when given, how many calls fail
+ * relative to the root (ending in `$`: a suffix of it), or `*` for every file under it; COUNT, when given, how many calls fail
  * before the rule is spent. A failing call does nothing and returns -1 with that errno, as the
  * kernel does for a full disk or a device error. An empty file injects nothing.
  *
@@ -167,7 +167,10 @@ static int injected(int fd, int is_fsync)
 		struct rule *r = &rules[i];
 		if (r->is_fsync != is_fsync || r->count == 0)
 			continue;
-		if (strcmp(r->match, "*") == 0 || strstr(rel, r->match)) {
+		size_t m = strlen(r->match), n = strlen(rel);
+		int anchored = m > 0 && r->match[m - 1] == '$';
+		if (strcmp(r->match, "*") == 0 || (anchored ? n >= m - 1 && strncmp(rel + n - (m - 1), r->match, m - 1) == 0
+							    : strstr(rel, r->match) != NULL)) {
 			e = r->err;
 			if (r->count > 0)
 				r->count--;

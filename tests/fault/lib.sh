@@ -139,3 +139,64 @@ for j, attempt in db.execute("SELECT l.job_id, l.attempt FROM log_chunks l JOIN 
 report("no_stale_result", problems)
 PY
 }
+
+# submit_once KEY: one submission of $FAULT_CASE (a submission body) with Idempotency-Key KEY to
+# $SVC_URL as $FAULT_USER; prints the status, the body in $SVC_BODY. A 200 or 201 is appended to
+# $FAULT_RECORD as poro-load records it ("key status job_id"), for check_store.
+submit_once() {
+	local code id
+	code=$(svc_req POST /v1/jobs "$FAULT_USER" -H "Idempotency-Key: $1" -H 'Content-Type: application/json' \
+		--data-binary "@$FAULT_CASE")
+	if [ "$code" = 200 ] || [ "$code" = 201 ]; then
+		id=$(json '["id"]' < "$SVC_BODY")
+		echo "$1 $code $id" >> "$FAULT_RECORD"
+	fi
+	echo "$code"
+}
+
+# health_is STATUS: /healthz of $SVC_URL answers STATUS (200 or 503).
+health_is() {
+	[ "$(curl -s -o /dev/null -w '%{http_code}' "$SVC_URL/healthz")" = "$1" ]
+}
+
+# refusal_is CODE STATUS: the last answer ($SVC_BODY, $SVC_HEADERS) is the JSON error CODE with
+# HTTP status STATUS, a message and a Retry-After header.
+refusal_is() {
+	[ "$(json '["error"]["code"]' < "$SVC_BODY")" = "$1" ] && [ -n "$(json '["error"]["message"]' < "$SVC_BODY")" ] &&
+		[ -n "$(svc_header Retry-After)" ] && grep -q "^HTTP/1.1 $2 " "$SVC_HEADERS"
+}
+
+# fault_client_init NAME: tokens of a user (FAULT_USER) and a worker (FAULT_POOL) on instance
+# NAME, the submission body FAULT_CASE (tiny_column.json), an empty FAULT_RECORD, and three
+# acknowledged submissions before any fault.
+fault_client_init() {
+	FAULT_USER=$(svc_token "$1" alice user)
+	FAULT_POOL=$(svc_token "$1" pool worker)
+	FAULT_CASE="$SVC_TMP/submission.json"
+	FAULT_RECORD="$SVC_TMP/record.txt"
+	: > "$FAULT_RECORD"
+	python3 -c 'import json, sys; json.dump({"case": json.load(open(sys.argv[1]))}, open(sys.argv[2], "w"))' \
+		tests/fault/tiny_column.json "$FAULT_CASE"
+	local i
+	for i in 1 2 3; do submit_once "before-$i" > /dev/null; done
+	check submissions_before_faults_acknowledged "$([ "$(wc -l < "$FAULT_RECORD")" = 3 ]; echo $?)" "$(cat "$FAULT_RECORD")"
+}
+
+# fault_claim BYTES: the worker claims a job (FAULT_JOB, FAULT_ATTEMPT) and makes a random
+# result.h5 of BYTES to upload with fault_upload.
+fault_claim() {
+	local code
+	code=$(svc_req POST /v1/worker/claim "$FAULT_POOL" -H 'Content-Type: application/json' \
+		--data '{"worker": "w:1", "host": "w", "threads": 1, "wait_seconds": 5}')
+	FAULT_JOB=$(json '["job"]["id"]' < "$SVC_BODY")
+	FAULT_ATTEMPT=$(json '["job"]["attempt"]' < "$SVC_BODY")
+	check worker_claims "$([ "$code" = 200 ] && [ -n "$FAULT_JOB" ]; echo $?)" "status $code"
+	head -c "$1" /dev/urandom > "$SVC_TMP/result.h5"
+	FAULT_SUM=$(sha256sum < "$SVC_TMP/result.h5" | cut -d' ' -f1)
+}
+
+# fault_upload: uploads that result.h5 for the claimed attempt; prints the status.
+fault_upload() {
+	svc_req PUT "/v1/worker/jobs/$FAULT_JOB/files/result.h5?attempt=$FAULT_ATTEMPT" "$FAULT_POOL" \
+		-H "X-Checksum-Sha256: $FAULT_SUM" --data-binary "@$SVC_TMP/result.h5"
+}
