@@ -96,13 +96,15 @@ options() {
 
 FORK="-fork=1 -ignore_crashes=1 -ignore_timeouts=1 -ignore_ooms=1"
 
-# triage TARGET FILE: "libhdf5" when the input's fault (crash or hang) happens inside libhdf5
-# (the first frame of the report below the sanitizer's and libFuzzer's own lies in it), else
-# "poro" (a fault in PoroMPM's code, to be fixed).
+# triage TARGET FILE: "libhdf5" when the input's fault (crash, hang or leak) happens inside
+# libhdf5: the first frame of the report that lies in libhdf5 or in a source file comes before any
+# of PoroMPM's (the sanitizers' interceptors, such as malloc, have no source file); else "poro"
+# (a fault in PoroMPM's code, to be fixed).
 triage() {
 	local out
-	out=$(FUZZ_CASE="$PWD/tests/fault/tiny_column.json" timeout 60 "$fb/fuzz/${1}_fuzz" -timeout=10 -close_fd_mask=3 \
-		"$2" 2>&1 | grep -E '^ +#[0-9]+ 0x' | grep -vE 'sanitizer|fuzzer::|libc\.so|__interceptor|AlarmCallback' | head -1)
+	out=$(FUZZ_CASE="$PWD/tests/fault/tiny_column.json" ASAN_OPTIONS=fast_unwind_on_malloc=0 timeout 120 \
+		"$fb/fuzz/${1}_fuzz" -timeout=10 -close_fd_mask=3 "$2" 2>&1 | grep -E '^ +#[0-9]+ 0x' |
+		grep -E 'libhdf5|\.c:[0-9]+' | grep -vE 'compiler-rt|sanitizer_common|/fuzzer/' | head -1)
 	case $out in *libhdf5*) echo libhdf5 ;; *) echo poro ;; esac
 }
 
