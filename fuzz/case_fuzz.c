@@ -9,7 +9,7 @@
  * A disagreement aborts, so the fuzzer reports it like a crash. Refusals must say something:
  * an empty message for a refused case would reach users as an empty problem list.
  *
- * Seeds: tests/cases/*.json (fuzz/run.sh copies them); dictionary fuzz/case.dict.
+ * Seeds: the cases of tests/cases (fuzz/run.sh copies them); dictionary fuzz/case.dict.
  */
 #include "case.h"
 

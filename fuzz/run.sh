@@ -118,7 +118,7 @@ run_target() {
 	local status=$?
 	local done_line cpu crashes
 	done_line=$(grep -E '^#[0-9]+[[:space:]]+DONE|^#[0-9]+: cov:' "$log" | tail -1)
-	cpu=$(awk '{ printf "%.0f", $1 + $2 }' "$fb/logs/$t.cpu" 2> /dev/null)
+	cpu=$(tail -1 "$fb/logs/$t.cpu" 2> /dev/null | awk '{ printf "%.0f", $1 + $2 }')
 	crashes=$(find "$fb/crashes/$t" -type f | wc -l)
 	local runs cov ft corp
 	runs=$(sed -n 's/^stat::number_of_executed_units: *//p' "$log" | tail -1)
