@@ -37,11 +37,12 @@ for cycle in $(seq "$cycles"); do
 	pool=$(env LD_PRELOAD="$FAULT_SHIM" PORO_CRASH_ROOT="$state" PORO_CRASH_IMAGE="$img" \
 		"$build/poro-server" token create --state "$state" --user pool --role worker)
 	svc_record_token "$user"; svc_record_token "$pool"
+	(umask 077 && printf '%s\n' "$pool" > "$SVC_TMP/pool-$cycle.token")
 	start_server_at "$state" "$port" "$SVC_TMP/server-$cycle.log" "${shim[@]}" --lease-seconds 5
 	check "cycle${cycle}_server_starts_under_shim" $? "$(tail -3 "$SVC_TMP/server-$cycle.log")"
 	server=$SERVER_PID
 	pids+=("$server")
-	"$build/poro-worker" --server "http://127.0.0.1:$port" --token "$pool" --work "$SVC_TMP/work-$cycle" \
+	"$build/poro-worker" --server "http://127.0.0.1:$port" --token-file "$SVC_TMP/pool-$cycle.token" --work "$SVC_TMP/work-$cycle" \
 		--solver "$build/poro-solve" --slots 2 --threads 2 --name "w$cycle" > "$SVC_TMP/worker-$cycle.log" 2>&1 &
 	worker=$!
 	pids+=("$worker")

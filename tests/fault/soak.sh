@@ -48,10 +48,11 @@ check soak_server_starts $? "$(tail -3 "$SVC_TMP/server.log")"
 user=$("$build/poro-server" token create --state "$state" --user soak --role user)
 pool=$("$build/poro-server" token create --state "$state" --user pool --role worker)
 svc_record_token "$user"; svc_record_token "$pool"
+(umask 077 && printf '%s\n' "$pool" > "$SVC_TMP/pool.token")
 starts=0
 start_worker() { # NAME
 	starts=$((starts + 1))
-	"$build/poro-worker" --server "$url" --token "$pool" --work "$SVC_TMP/work-$1-$starts" --solver "$build/poro-solve" \
+	"$build/poro-worker" --server "$url" --token-file "$SVC_TMP/pool.token" --work "$SVC_TMP/work-$1-$starts" --solver "$build/poro-solve" \
 		--slots 2 --threads 2 --name "$1" >> "$SVC_TMP/$1.log" 2>&1 &
 	worker_pid[$1]=$!
 }
