@@ -11,15 +11,23 @@
 
 #define FS_PATH_MAX 4096
 
-int fs_make_dirs(const char *path)
+/* Copies path into buf[FS_PATH_MAX]: 0, or -1 with ENAMETOOLONG. */
+static int path_copy(char *buf, const char *path)
 {
-	char buf[FS_PATH_MAX];
 	size_t n = strlen(path);
-	if (n >= sizeof buf) {
+	if (n >= FS_PATH_MAX) {
 		errno = ENAMETOOLONG;
 		return -1;
 	}
 	memcpy(buf, path, n + 1);
+	return 0;
+}
+
+int fs_make_dirs(const char *path)
+{
+	char buf[FS_PATH_MAX];
+	if (path_copy(buf, path) != 0)
+		return -1;
 	for (char *p = buf + 1; *p; p++) {
 		if (*p != '/')
 			continue;
@@ -34,12 +42,8 @@ int fs_make_dirs(const char *path)
 int fs_sync_parents(const char *path, int levels)
 {
 	char buf[FS_PATH_MAX];
-	size_t n = strlen(path);
-	if (n >= sizeof buf) {
-		errno = ENAMETOOLONG;
+	if (path_copy(buf, path) != 0)
 		return -1;
-	}
-	memcpy(buf, path, n + 1);
 	for (int i = 0; i < levels; i++) {
 		char *slash = strrchr(buf, '/');
 		if (!slash)
