@@ -75,9 +75,10 @@ for j, (st, attempt, message) in jobs.items():
     for a, name, size in files.get(j, []):
         if a > attempt:
             problem("job %d: file '%s' of attempt %d after its last (%d)" % (j, name, a, attempt))
-        # a running job's files may be replaced by a newer snapshot while this reads
+        # a running job's file may be replaced by a newer version (result.h5 grows at each
+        # checkpoint) between this read and the stat below: its size is checked once it ended
         path = os.path.join(state, "files", str(j), str(a), name)
-        if st in TERMINAL and not os.path.isfile(path) or os.path.getsize(path) != size:
+        if not os.path.isfile(path) or st in TERMINAL and os.path.getsize(path) != size:
             problem("job %d: indexed file %s is not on disk at %d bytes" % (j, path, size))
     if st == "succeeded":
         wins = [e for e in ev if e[1] == "succeeded"]
