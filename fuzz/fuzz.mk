@@ -56,7 +56,7 @@ $(FUZZ_BUILD)/libporo.a: $(FUZZ_SOLVER_OBJ)
 	$(call quiet,AR)ar rcs $@ $^
 
 FUZZ_LINK = $(FUZZ_CC) -fopenmp $(FUZZ_SAN) -fsanitize=fuzzer
-FUZZ_SOLVER_LIBS = $(shell pkg-config --libs hdf5 2>/dev/null) -lcholmod -lm
+FUZZ_SOLVER_LIBS = $(shell pkg-config --libs hdf5 2>/dev/null) -lumfpack -lcholmod -lm
 
 $(FUZZ_BUILD)/fuzz/case_fuzz: $(FUZZ_BUILD)/fuzz/case_fuzz.o $(FUZZ_BUILD)/libporo.a
 	$(call quiet,LD)$(FUZZ_LINK) $^ $(FUZZ_JANSSON_LINK) $(FUZZ_SOLVER_LIBS) -o $@
