@@ -32,9 +32,16 @@ packages=(
   man-db                # man -l: the same test renders the installed man pages
 )
 
+# `deps.sh fuzz` (make fuzz) adds what the fuzzers build with: clang with libFuzzer and its
+# sanitizer runtimes, clang's OpenMP runtime, and dpkg-source to unpack jansson's Debian source
+# (fuzz/jansson.sh). make test needs none of them.
+if [ "${1:-}" = fuzz ]; then
+  packages=(clang libclang-rt-14-dev libomp-dev dpkg-dev)
+fi
+
 # The OpenAPI linter of make test (tools/openapi-lint, pinned in its package-lock.json) runs on
 # Node.js >= 20.19; Debian's nodejs package is installed only where no node is present at all.
-command -v node >/dev/null 2>&1 || packages+=(nodejs npm)
+[ "${1:-}" = fuzz ] || command -v node >/dev/null 2>&1 || packages+=(nodejs npm)
 
 missing=()
 for p in "${packages[@]}"; do

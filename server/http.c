@@ -250,6 +250,14 @@ void reply_header(struct request *r, const char *name, const char *value)
 	rep->header_count++;
 }
 
+static int reply_has_header(struct request *r, const char *name)
+{
+	for (int i = 0; i < r->reply.header_count; i++)
+		if (strcasecmp(r->reply.headers[i][0], name) == 0)
+			return 1;
+	return 0;
+}
+
 void reply_text(struct request *r, int status, const char *content_type, char *owned_text, size_t size)
 {
 	free(r->reply.body);
@@ -285,7 +293,11 @@ void reply_error(struct request *r, struct api_error *err)
 	if (err->code == API_LOG_GAP)
 		json_object_set_new(e, "expected_offset", json_integer(err->expected_offset));
 	reply_header(r, "Cache-Control", "no-store");
-	reply_json(r, api_code_status(err->code), json_pack("{s:o}", "error", e));
+	/* the server's passing states (no memory, a failing or full disk) say when to try again */
+	int status = api_code_status(err->code);
+	if ((status == 503 || status == 507) && !reply_has_header(r, "Retry-After"))
+		reply_header(r, "Retry-After", status == 507 ? "10" : "1");
+	reply_json(r, status, json_pack("{s:o}", "error", e));
 }
 
 enum api_code reply_fail(struct request *r, enum api_code code, const char *field, const char *fmt, ...)

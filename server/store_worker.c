@@ -601,7 +601,7 @@ static enum api_code file_run(struct store *s, struct conn *c, void *arg, struct
 	if ((rc = step_done(c, st, err, "indexing a file")) != API_OK)
 		return rc;
 	if (rename(op->tmp_path, op->final_path) != 0 || fsync_dir_of(op->final_path) != 0)
-		return api_fail(err, API_INTERNAL, "", "cannot store file '%s': %s", op->name, strerror(errno));
+		return api_fail(err, api_storage_code(errno), "", "cannot store file '%s': %s", op->name, strerror(errno));
 	return API_OK;
 }
 
