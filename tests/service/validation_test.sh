@@ -84,7 +84,7 @@ over_limit cells_1.6e9 'c["grid"]["extent"] = [1000.0, 1000.0]' /case/grid \
 over_limit end_1e12 'c["time"]["end"] = 1e12; c["output"]["frame_interval"] = 0' /case/time/end \
 	"must take at most 1000000000 steps of /time/dt (the case limit), got 1e+16"
 over_limit dt_above_cfl 'c["time"]["dt"] = 2e-3' /case/time/dt \
-	"must be at most 0.000426 s, 1.25 times the soil skeleton's CFL step h / c_p = 0.00034 s (c_p = sqrt((K + 4G/3) / ((1 - n) rho_s)) = 73.42 m/s in body 'column'), got 0.002"
+	"must be at most 0.000426 s, 1.25 times the soil skeleton's CFL step h / c_p = 0.00034 s (c_p = sqrt((K + 4G/3) / ((1 - n) rho_s)) = 73.42 m/s in body 'column'), got 0.002 (or write \"auto\")"
 over_limit probes_40000 \
 	'c["probes"] = [{"name": "p%d" % i, "kind": "pore_pressure", "point": [0.05, 0.5]} for i in range(40000)]' \
 	/case/probes "must list at most 10000 probes (the case limit), got 40000"

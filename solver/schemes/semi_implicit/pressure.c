@@ -16,8 +16,13 @@
  *    velocities then satisfy the weak continuity equation -G^T v = 0 exactly, and the pressure
  *    forces of the predictors use the same G on the nodal pressure, so a pressure error is removed
  *    in one step instead of being fed back (docs/numerics.md has the measurements).
- *    Equal-order B-splines leave a node-to-node pressure pattern nearly outside A's reach; the
- *    case may hold it down with formulation.pressure_stabilisation (pressure_stabilisation.c).
+ *    Equal-order B-splines leave a node-to-node pressure pattern nearly outside A's reach (on a
+ *    regular seeding exactly: G of the alternation vanishes wherever the points are symmetric
+ *    about the nodes, pressure_test), and the solve gives it whatever the near-null ratio of the
+ *    right-hand side to its eigenvalue is, every step afresh: the failing Mohr-Coulomb slopes
+ *    show it as stripes of period two cells (docs/numerics.md, "A pressure pattern of period two
+ *    cells"). The case may hold it down with formulation.pressure_stabilisation
+ *    (pressure_stabilisation.c).
  *
  * Boundary conditions: impermeable faces need nothing (the natural condition of Eq. 32). Where
  * the pressure is zero, on the free water surface and on drained faces, free_surface.c decides,
