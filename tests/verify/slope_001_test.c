@@ -68,7 +68,7 @@ static double surface(const struct ground *g, double x)
 }
 
 /* Sets each point's pore pressure to hydrostatic below the local surface and its effective stress
- * to the K0 state of its depth (file comment), with p0 = p (001's simulation starts there); with
+ * to the K0 state of its depth (file comment; 001's simulation starts there); with
  * `dry_pressure` the pore pressure stays 0 and the skeleton carries the saturated weight (the clay
  * of §4.2.1, whose water's weight reaches the skeleton through the drag). */
 static void set_geostatic(struct sim *s, const struct ground *gr, int dry_pressure)
@@ -88,7 +88,7 @@ static void set_geostatic(struct sim *s, const struct ground *gr, int dry_pressu
 		st[2] = 0.0;
 		material_init_state(m, st, p->Be + 4 * q, p->state + STATE_MAX * q);
 		if (q < w->n)
-			w->pressure[q] = w->pressure0[q] = dry_pressure ? 0.0 : -s->rho_w * G * d; /* tension + */
+			w->pressure[q] = dry_pressure ? 0.0 : -s->rho_w * G * d;   /* tension positive */
 	}
 }
 
@@ -221,11 +221,11 @@ static struct sand_run run_sand(double k, double end)
 	set_geostatic(s, &gr, 0);
 	static const double A[2] = {5.5, 1.2};
 	const idx_t qA = nearest_point(s, A);
-	const double t0 = harness_wall_seconds();
+	const double pA0 = s->water.pressure[qA], t0 = harness_wall_seconds();
 	int ok = 1;
 	while (ok && !sim_done(s)) {
 		ok = !sim_step(s);
-		const double excess = -(s->water.pressure[qA] - s->water.pressure0[qA]);   /* compression + */
+		const double excess = -(s->water.pressure[qA] - pA0);   /* compression positive */
 		if (ok && excess > r.peak)
 			r.peak = excess, r.peak_time = sim_time(s);
 		r.final = excess;

@@ -12,9 +12,9 @@
  * then stops the run (at h = 0.5 m at q/c = 6.01, d/B = 0.0193, its energy 5e-16 of the first's
  * but a displacement correction above 1e-8 h: docs/numerics.md, "001's examples"), so spec-001's
  * d/B = 0.02 is not always reached; between 0.01 and 0.02 the curve moves by 1% of q.
- *  - make test: h = 0.5 m with B-bar and without, to q/c = 7.5. With B-bar the limit is
- *    within H05_LIMIT_BAND of Prandtl's 2 + pi (one cell under the half footing overestimates, as
- *    every low-order method does); without B-bar (001 Eq. 12's plain GIMP gradients) the soil
+ *  - make test: h = 0.5 m with B-bar and without, to q/c = 7.5. With B-bar a limit is reached,
+ *    not below Prandtl's 2 + pi, and at most H05_LIMIT_BAND above it (one cell under the half
+ *    footing overestimates, as every low-order method does; measured +15.7%, XFAIL); without B-bar (001 Eq. 12's plain GIMP gradients) the soil
  *    locks (Fig. 4): no limit load, or one LOCKING_MARGIN above B-bar's; and its mean-stress
  *    oscillation index (oscillation.h) at the end is OSCILLATION_RATIO times B-bar's (Fig. 5).
  *    001's Fig. 3 gives no domain size: with the soil 7.5 m x 7.5 m instead of 5 m x 5 m the
@@ -46,8 +46,8 @@
 #define FOOTING_B 1.0         /* m: the footing's breadth, twice the half model's loaded span */
 #define LIMIT_SETTLEMENT 0.01 /* d/B read as collapse (file comment) */
 #define PRANDTL 5.141592653589793 /* 2 + pi, Prandtl's q/c */
-#define H05_LIMIT_BAND 0.20   /* h = 0.5 m: within +20% / -3% of 2 + pi (spec-001: <= +15% at one
-				 cell under the half footing; measured below) */
+#define H05_LIMIT_BAND 0.15   /* h = 0.5 m: at most +15% of 2 + pi (spec-001 §9.1, one cell under the
+				 half footing); measured +15.7%, a known failure */
 #define LIMIT_BELOW 0.03      /* no mesh may fall more than 3% below 2 + pi */
 #define FINE_TOLERANCE 0.03   /* h = 0.1 and 0.05 m */
 #define MESH_NOISE 0.01       /* the limit may rise by 1% as h falls (spec-001 §9.1) */
@@ -164,12 +164,13 @@ static void print_sd(const char *label, double h, const struct footing_run *r)
 
 /* Without B-bar: a limit load LOCKING_MARGIN above B-bar's, or none up to a run's end that lies
  * that far above it. */
-static void check_locking(const char *name, const struct footing_run *bbar, const struct footing_run *none)
+static void check_locking(const char *name, const struct footing_run *bbar, const struct footing_run *none,
+			  int known)
 {
 	const double above = (1 + LOCKING_MARGIN) * bbar->q_limit;
 	const int locked = bbar->reached && (none->reached ? none->q_limit >= above : none->q_end >= above);
-	CHECK(locked, name, "no B-bar q_lim/c %.4f (reached %d) against B-bar %.4f", none->q_limit, none->reached,
-	      bbar->q_limit);
+	CHECK_UNLESS_KNOWN(known, locked, name, "no B-bar q_lim/c %.4f (reached %d) against B-bar %.4f (reached %d)",
+			   none->q_limit, none->reached, bbar->q_limit, bbar->reached);
 }
 
 static void small_deformation(int long_run)
@@ -179,10 +180,12 @@ static void small_deformation(int long_run)
 	struct footing_run none = run_footing(file, 0.5, STABILISATION_NONE, SD_SHORT_END, 0);
 	print_sd("B-bar", 0.5, &bbar);
 	print_sd("no B-bar", 0.5, &none);
-	CHECK(bbar.reached && bbar.q_limit >= (1 - LIMIT_BELOW) * PRANDTL &&
-	      bbar.q_limit <= (1 + H05_LIMIT_BAND) * PRANDTL, "strip_footing_001_h0.5_limit_load_near_prandtl",
+	CHECK(bbar.reached && bbar.q_limit >= (1 - LIMIT_BELOW) * PRANDTL, "strip_footing_001_h0.5_limit_load_reached",
 	      "q_lim/c %.4f (reached %d)", bbar.q_limit, bbar.reached);
-	check_locking("strip_footing_001_h0.5_locks_without_bbar", &bbar, &none);
+	CHECK_KNOWN_FAILURE(bbar.reached && bbar.q_limit <= (1 + H05_LIMIT_BAND) * PRANDTL,
+			    "strip_footing_001_h0.5_limit_load_within_15pct_of_prandtl", "q_lim/c %.4f, %+.2f%%",
+			    bbar.q_limit, 100 * (bbar.q_limit / PRANDTL - 1));
+	check_locking("strip_footing_001_h0.5_locks_without_bbar", &bbar, &none, 0);
 	/* 001's Fig. 3 gives no size: the 5 m domain is large enough if 7.5 m moves q_lim by < 1%
 	 * (spec-001 §9.1) */
 	struct footing_run large = run_footing(file, 0.5, STABILISATION_BBAR, SD_SHORT_END, LARGE_DOMAIN);
@@ -207,17 +210,23 @@ static void small_deformation(int long_run)
 		falls = falls && fine[k].reached && fine[k].q_limit <= (1 + MESH_NOISE) * previous;
 		previous = fine[k].q_limit;
 	}
-	CHECK(falls, "strip_footing_001_limit_load_falls_with_h", "q_lim/c %.4f, %.4f, %.4f, %.4f at h = 0.5, 0.25, "
-	      "0.1, 0.05 m", bbar.q_limit, fine[0].q_limit, fine[1].q_limit, fine[2].q_limit);
+	/* Known: at h = 0.25 m the modified Newton-Raphson iteration stops the run at q/c = 5.44, d/B =
+	 * 0.0021, before the limit, its energy at round-off but a displacement correction above 1e-8 h
+	 * (docs/numerics.md, "001's examples"); h = 0.1 and 0.05 m were not run (hours each). */
+	const int stops = 1;
+	CHECK_UNLESS_KNOWN(stops, falls, "strip_footing_001_limit_load_falls_with_h", "q_lim/c %.4f, %.4f, %.4f, %.4f "
+			   "at h = 0.5, 0.25, 0.1, 0.05 m (0: not reached)", bbar.q_limit, fine[0].q_limit,
+			   fine[1].q_limit, fine[2].q_limit);
 	for (int k = 1; k < 3; k++) {
 		char name[96];
 		snprintf(name, sizeof name, "strip_footing_001_h%g_limit_load_within_3pct_of_prandtl", hs[k]);
-		CHECK(fine[k].reached && fabs(fine[k].q_limit / PRANDTL - 1) <= FINE_TOLERANCE, name,
-		      "q_lim/c %.4f", fine[k].q_limit);
+		CHECK_UNLESS_KNOWN(stops, fine[k].reached && fabs(fine[k].q_limit / PRANDTL - 1) <= FINE_TOLERANCE,
+				   name, "q_lim/c %.4f (0: not reached; %s)", fine[k].q_limit,
+				   fine[k].ok ? "ran" : fine[k].failure);
 	}
 	struct footing_run none025 = run_footing(file, 0.25, STABILISATION_NONE, 0, 0);
 	print_sd("no B-bar", 0.25, &none025);
-	check_locking("strip_footing_001_h0.25_locks_without_bbar", &fine[0], &none025);
+	check_locking("strip_footing_001_h0.25_locks_without_bbar", &fine[0], &none025, stops);
 }
 
 static void large_deformation(int long_run)
@@ -228,13 +237,14 @@ static void large_deformation(int long_run)
 	       "%.3f; rising beyond d/B = 0.05: %d; %.1f s of wall time%s%s\n", r.ok ? "ran" : "FAILED", r.q_end,
 	       r.d_end, r.q_at_01, r.q_at_1, r.monotone, r.seconds, r.ok ? "" : ": ", r.failure);
 	if (!long_run) {
-		/* elastic at q/c = 2: the settlement of a rough rigid strip on an elastic layer is of
-		 * order q B (1 - nu^2) / E; 001's Fig. 7 starts from d/B ~ 0.02 at that load */
+		/* elastic at q/c = 2: within a factor of three of the order of a strip's settlement on
+		 * an elastic layer, q B (1 - nu^2) / E = 0.015 B */
 		CHECK(r.ok && r.d_end > 0.005 && r.d_end < 0.05, "strip_footing_large_001_elastic_start",
 		      "d/B %.4f at q/c %.3f", r.d_end, r.q_end);
 		return;
 	}
-	/* the run stops where the footing's base crosses a grid line (file comment) */
+	/* the run stops at q/c = 5.33, a point beside the footing's corner over-compressed (file
+	 * comment) */
 	const int known = 1;
 	CHECK_UNLESS_KNOWN(known, r.ok && r.q_at_01 >= 5.1 && r.q_at_01 <= 6.0,
 			   "strip_footing_large_001_q_at_0.1B_in_5.1_6.0", "q/c %.3f at d/B = 0.1 (%s)", r.q_at_01,
