@@ -31,8 +31,8 @@
  * q is the applied pressure (001 reads the contact force, which differs from it by the block's
  * inertia under a load rising over a minute). Asserted (spec-001 §9.2): q/c at d/B = 0.1 within
  * [5.1, 6.0], rising after d/B = 0.05, and at d/B = 1 within [5.7, 7.5]. The run stops at
- * q/c = 5.33, d/B = 0.063, a point beside the footing's corner over-compressed to J = 0.59
- * (docs/numerics.md, "001's examples"): reported as XFAIL while that lasts. make test runs it to
+ * q/c = 5.33, d/B = 0.066 (Newton, its energy at round-off; earlier a point beside the footing's
+ * corner over-compressed to J = 0.59; docs/numerics.md, "001's examples"): XFAIL while that lasts. make test runs it to
  * t = LD_SHORT_END (elastic), make verify to d/B = 1.
  */
 #include <string.h>
@@ -243,8 +243,7 @@ static void large_deformation(int long_run)
 		      "d/B %.4f at q/c %.3f", r.d_end, r.q_end);
 		return;
 	}
-	/* the run stops at q/c = 5.33, a point beside the footing's corner over-compressed (file
-	 * comment) */
+	/* the run stops at q/c = 5.33 (file comment) */
 	const int known = 1;
 	CHECK_UNLESS_KNOWN(known, r.ok && r.q_at_01 >= 5.1 && r.q_at_01 <= 6.0,
 			   "strip_footing_large_001_q_at_0.1B_in_5.1_6.0", "q/c %.3f at d/B = 0.1 (%s)", r.q_at_01,
