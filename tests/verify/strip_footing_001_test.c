@@ -9,9 +9,8 @@
  * footing's centre first reaches d/B = 0.01, ten times the elastic settlement at collapse
  * (interpolated between steps); a run whose settlement stays below it has no limit load. Under
  * load control the footing runs away past the limit and the modified Newton-Raphson iteration
- * then stops the run (at h = 0.5 m at q/c = 6.01, d/B = 0.0193, its energy 5e-16 of the first's
- * but a displacement correction above 1e-8 h: docs/numerics.md, "001's examples"), so spec-001's
- * d/B = 0.02 is not always reached; between 0.01 and 0.02 the curve moves by 1% of q.
+ * then stops the run (at h = 0.5 m at q/c = 6.31, d/B = 0.144: docs/numerics.md, "001's
+ * examples"); between d/B = 0.01 and spec-001's 0.02 the curve moves by 1% of q.
  *  - make test: h = 0.5 m with B-bar and without, to q/c = 7.5. With B-bar a limit is reached,
  *    not below Prandtl's 2 + pi, and at most H05_LIMIT_BAND above it (one cell under the half
  *    footing overestimates, as every low-order method does; measured +15.7%, XFAIL); without B-bar (001 Eq. 12's plain GIMP gradients) the soil
@@ -31,8 +30,9 @@
  * q is the applied pressure (001 reads the contact force, which differs from it by the block's
  * inertia under a load rising over a minute). Asserted (spec-001 §9.2): q/c at d/B = 0.1 within
  * [5.1, 6.0], rising after d/B = 0.05, and at d/B = 1 within [5.7, 7.5]. The run stops at
- * q/c = 5.33, d/B = 0.066 (Newton, its energy at round-off; earlier a point beside the footing's
- * corner over-compressed to J = 0.59; docs/numerics.md, "001's examples"): XFAIL while that lasts. make test runs it to
+ * q/c = 5.33, d/B = 0.066 (Newton, its energy at round-off, before a step could converge on its
+ * residual; earlier a point beside the footing's corner over-compressed to J = 0.59;
+ * docs/numerics.md, "001's examples"): XFAIL while that lasts. make test runs it to
  * t = LD_SHORT_END (elastic), make verify to d/B = 1.
  */
 #include <string.h>
