@@ -9,8 +9,9 @@
  * write, only if the attempt still holds the lease (store_file_commit). A file without an index
  * row is never served. Names are checked before anything touches the disk (api_file_name).
  *
- * probes.json is the one file whose content the server checks: it is served as the answer of GET
- * /v1/jobs/{id}/probes, so it must be one JSON object. json_scan checks it while it streams in, in
+ * probes.json and frames.json are the files whose content the server checks: they are served as
+ * the answers of GET /v1/jobs/{id}/probes and GET /v1/jobs/{id}/frames (frames.c reads the
+ * latter's ranges), so each must be one JSON object. json_scan checks it while it streams in, in
  * constant memory, within JSON_FILE_MAX_BYTES (or --max-upload-bytes when smaller), a nesting depth
  * and a token length; a file that fails is 422 invalid_json_file naming the line and column, and
  * is not stored. The server never parses result files (docs/service.md §3, "Probes").
@@ -36,6 +37,7 @@
 #define ATTEMPT_MAX 1000000
 #define NAME_SIZE 129
 #define JSON_FILE_NAME "probes.json"
+#define FRAMES_INDEX_NAME "frames.json"   /* served as GET /v1/jobs/{id}/frames (frames.c) */
 #define JSON_FILE_MAX_BYTES (256LL << 20) /* bytes: 3 probes of 2 million steps (120 bytes a step) */
 #define JSON_FILE_DEPTH_MAX 16            /* the probes document nests 4 deep */
 #define JSON_FILE_TOKEN_MAX 4096          /* bytes of one string or number */
@@ -72,7 +74,7 @@ static int checksum_header(struct request *r, char out[DIGEST_HEX_SIZE])
 /* A file the server serves as JSON is checked as it arrives: 0, or -1 after replying 413. */
 static int json_file_begin(struct request *r, struct upload *u)
 {
-	if (strcmp(u->name, JSON_FILE_NAME) != 0)
+	if (strcmp(u->name, JSON_FILE_NAME) != 0 && strcmp(u->name, FRAMES_INDEX_NAME) != 0)
 		return 0;
 	u->json = 1;
 	u->limit = JSON_FILE_MAX_BYTES < r->srv->cfg.max_upload_bytes ? JSON_FILE_MAX_BYTES : r->srv->cfg.max_upload_bytes;

@@ -144,6 +144,14 @@ static const char *const MIGRATIONS[] = {
 	"  id INTEGER PRIMARY KEY CHECK (id = 1),"
 	"  checked_at INTEGER NOT NULL,"
 	"  writes INTEGER NOT NULL);",
+
+	/* 4: the dashboard's job search (store_search.c): the case's title beside the job, kept at
+	 * submission, and two covering indexes, so that a filter on state, dates, the job's name or
+	 * the case's title reads index entries alone, never a job's case text */
+	"ALTER TABLE jobs ADD COLUMN case_title TEXT;"
+	"UPDATE jobs SET case_title = json_extract(case_json, '$.title') WHERE json_valid(case_json);"
+	"CREATE INDEX jobs_user_search ON jobs (user_id, id, state, created_at, name, case_title);"
+	"CREATE INDEX jobs_search ON jobs (id, state, created_at, user_id, name, case_title);",
 };
 
 #define MIGRATION_COUNT ((int)(sizeof MIGRATIONS / sizeof MIGRATIONS[0]))

@@ -71,7 +71,7 @@ int probes_start(struct probes_run *p, const char *dir, const char *result, long
 	snprintf(job, sizeof job, "%lld", id);
 	snprintf(attempt_text, sizeof attempt_text, "%d", attempt);
 	char *argv[] = { worker_opt.solver, "probes", (char *)result, "--job", job, "--attempt", attempt_text, "--out",
-			 PROBES_OUT, NULL };
+			 PROBES_OUT, "--frames", PROBES_FRAMES_DIR, NULL };
 	struct child_spec spec = { .dir = dir, .argv = argv, .memory_limit_mb = worker_opt.memory_limit_mb, .threads = 1,
 				   .secret = worker_opt.token };
 	int fd;
