@@ -32,7 +32,7 @@ if [ "$mode" = test ]; then
 	for t in "$build"/tests/verify/*_test "$build"/tests/solver/*_test "$build"/tests/common/*_test; do
 		[ -x "$t" ] && parallel+=("$t")
 	done
-	for t in tests/cli/*_test.sh tests/install/*_test.sh; do [ -f "$t" ] && serial+=("bash $t $build"); done
+	for t in tests/cli/*_test.sh tests/install/*_test.sh tests/web/*_test.sh; do [ -f "$t" ] && serial+=("bash $t $build"); done
 elif [ "$mode" = service ]; then
 	for t in "$build"/tests/common/*_test; do [ -x "$t" ] && parallel+=("$t"); done
 else
