@@ -18,6 +18,19 @@ function finiteSeries(s) {
   return [x, y];
 }
 
+// Tick labels that stay distinct at any scale (uPlot's own print -0 for -0.0004).
+function tick(v, step) {
+  if (v === 0) return '0';
+  const a = Math.abs(v);
+  if (a >= 1e5 || a < 1e-3 || step < 1e-3) return v.toExponential(Math.max(0, Math.min(3, Math.ceil(Math.log10(a / step)))));
+  const decimals = Math.max(0, Math.min(6, -Math.floor(Math.log10(step))));
+  return v.toLocaleString('en', { minimumFractionDigits: decimals, maximumFractionDigits: decimals });
+}
+const ticks = (u, values) => {
+  const step = values.length > 1 ? Math.abs(values[1] - values[0]) : Math.abs(values[0]) || 1;
+  return values.map((v) => tick(v, step));
+};
+
 // spec: {name, title, xLabel, yLabel, series: [{label, x, y, points, colour, dash}], width, height}
 // Returns the uPlot object (destroy() it when the chart goes), or null without data.
 export function chart(el, spec) {
@@ -45,7 +58,7 @@ export function chart(el, spec) {
   const opts = {
     title: spec.title, width, height: spec.height || 300, series,
     scales: { x: { time: false } },
-    axes: [{ label: spec.xLabel }, { label: spec.yLabel, size: 70 }],
+    axes: [{ label: spec.xLabel, values: ticks }, { label: spec.yLabel, size: 70, values: ticks }],
     legend: { live: false },
   };
   return new uPlot(opts, data, el);

@@ -118,7 +118,8 @@ export function render(root, { id }) {
     for (const [unit, series] of byUnit) {
       const el = h('div', { class: 'plot', id: `probes-${unit.replace(/\W/g, '_')}` });
       probes.append(el);
-      const c = chart(el, { name: `probes-${unit}`, title: `Probes (${unit})`, xLabel: 'time, s', yLabel: unit, series });
+      const width = Math.max(360, Math.floor((probes.clientWidth - 16) / Math.min(2, byUnit.size)));
+      const c = chart(el, { name: `probes-${unit}`, title: `Probes (${unit})`, xLabel: 'time, s', yLabel: unit, series, width });
       if (c) charts.push(c);
     }
     probes.dataset.attempt = String(doc.attempt);
@@ -145,7 +146,8 @@ export function render(root, { id }) {
     bar.firstChild.style.width = `${(100 * f).toFixed(2)}%`;
     bar.dataset.fraction = String(f);
     const parts = [];
-    if (p) parts.push(`t = ${Number(p.time).toPrecision(4)} s${endTime ? ' of ' + endTime + ' s' : ''}`, `step ${p.step}`, `${(100 * f).toFixed(1)}%`);
+    if (job.state === 'succeeded' && endTime) parts.push(`t = ${endTime} s, the end`, '100%');
+    else if (p) parts.push(`t = ${Number(p.time).toPrecision(4)} s${endTime ? ' of ' + endTime + ' s' : ''}`, `step ${p.step}`, `${(100 * f).toFixed(1)}%`);
     if (job.state === 'running') parts.push(`about ${fmtDuration(timeLeft(samples, job))} left`);
     if (p && p.us_per_mp_step) parts.push(`${Number(p.us_per_mp_step).toPrecision(3)} µs per point-step`);
     if (job.state === 'queued' && job.waiting) parts.push(`queued: ${job.waiting.message}`);

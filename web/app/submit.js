@@ -77,6 +77,7 @@ export function render(root) {
         where ? h('button', { class: 'link', onclick: () => { editor.focus(); editor.setSelectionRange(where.start, where.end); } }, `line ${where.line}`) : 'request',
         ' ', h('code', {}, pointer), ' ', p.message));
     }
+    if (marks.length) editor.scrollTop = Math.max(0, (Math.min(...marks.map((m) => m.line)) - 4) * LINE_PX);
     layout();
   }
 

@@ -8,7 +8,7 @@ import { h, clear, fmtValue } from './dom.js';
 import { loadIndex, loadFrame } from './frames.js';
 import { LUT, lutIndex, rgb } from './colour.js';
 
-const GREY = [190, 190, 190];
+const GREY = [212, 212, 212];
 
 export async function render(root, { id }) {
   root.append(h('h1', {}, h('a', { href: `#/jobs/${id}` }, `Job ${id}`), ' · field viewer'));
