@@ -55,7 +55,7 @@ cat > "$tmp/want.txt" <<'EOF'
 644 usr/share/poro/schemas/openapi.yaml
 644 usr/share/poro/schemas/results.md
 EOF
-[ -d web ] && (cd web && find . -type f | sed 's|^\./|644 usr/share/poro/web/|') >> "$tmp/want.txt"
+[ -d web ] && (cd web && find -L . -type f | sed 's|^\./|644 usr/share/poro/web/|') >> "$tmp/want.txt"
 # every file, and the directories of etc/ (an installed directory of its own there)
 (cd "$root" && { find . -type f; find ./etc -mindepth 1 -type d; } | sed 's|^\./||' | sort |
 	while read -r f; do echo "$(stat -c %a "$f") $f"; done) > "$tmp/got.txt"

@@ -11,7 +11,7 @@
 //   c. a bad case shows its JSON pointer error at its field and creates no job; another user's job
 //      is not listed and its page says not found; no token in any URL, the page's HTML, its
 //      console or its storage other than session storage.
-//   e. screenshots of the sign-in, jobs, submit, job, viewer, plots and admin pages.
+//   e. screenshots of the sign-in, jobs, submit, job, viewer, plots, benchmarks and admin pages.
 import { chromium } from 'playwright-core';
 import { spawn, execFileSync } from 'node:child_process';
 import fs from 'node:fs';
@@ -255,6 +255,11 @@ try {
     `plotted ${plotted.x.length} points, the run's last frame has ${run.y.length}; first plotted (${plotted.x[0]}, ${plotted.y[0]}), run (${run.y[0]}, ${run.p[0]})`);
   await page.waitForSelector('#plot-terzaghi .uplot');
   await shot(page, '09-plots-terzaghi');
+
+  await page.goto(`${url}/#/benchmarks`);
+  await page.waitForSelector('#benchmarks-none', { timeout: WAIT });
+  check('web_benchmarks_page_says_none_yet', true, '');
+  await shot(page, '10-benchmarks');
 
   await page.goto(`${url}/#/jobs`);
   await page.waitForSelector(`#jobs-rows tr[data-id="${jobId}"]`, { timeout: WAIT });

@@ -57,7 +57,8 @@ export function render(root, { id }) {
   const files = h('div', { id: 'job-files' });
   const logPre = h('pre', { class: 'log', id: 'log' });
   const logNote = h('p', { class: 'muted', id: 'log-note' }, 'The log appears when a worker runs the job.');
-  const probes = h('div', { id: 'probes', class: 'plots' });
+  const probes = h('div', { id: 'probes', class: 'plots' },
+    h('p', { class: 'muted' }, 'The probes appear with the first checkpoint the worker uploads, or at the end.'));
   const message = h('p', { class: 'error', id: 'job-message' });
   const charts = [];
 

@@ -7,6 +7,7 @@
 //   #/jobs/ID/plots         plots of a job                       (plots.js)
 //   #/submit                paste or upload a case               (submit.js)
 //   #/admin                 workers and queues (admins)          (admin.js)
+//   #/benchmarks            the nightlies' history               (plots.js)
 import { get, token } from './api.js';
 import { h, clear } from './dom.js';
 import * as signin from './signin.js';
@@ -24,6 +25,7 @@ const ROUTES = [
   [/^\/jobs$/, jobs, () => ({})],
   [/^\/submit$/, submit, () => ({})],
   [/^\/admin$/, admin, () => ({})],
+  [/^\/benchmarks$/, { render: plots.renderBenchmarks }, () => ({})],
 ];
 
 export const session = { admin: false, user: null };
@@ -41,7 +43,7 @@ function renderNav() {
   if (!token.get()) return;
   const here = parseHash().path;
   const link = (href, text) => h('a', { href, class: here.startsWith(href.slice(1)) ? 'active' : '' }, text);
-  nav.append(link('#/jobs', 'Jobs'), link('#/submit', 'Submit'));
+  nav.append(link('#/jobs', 'Jobs'), link('#/submit', 'Submit'), link('#/benchmarks', 'Benchmarks'));
   if (session.admin) nav.append(link('#/admin', 'Admin'));
   who.append(session.user ? `${session.user}${session.admin ? ' (admin)' : ''}` : session.admin ? 'admin' : '',
              h('button', { class: 'link', id: 'sign-out', onclick: signOut }, 'Sign out'));

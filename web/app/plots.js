@@ -6,7 +6,8 @@
 //     extracted with the frames (frames.json "report", docs/report.md);
 //   - a footing (a load on part of a face): the load-settlement curve, the load from the case's
 //     time function and the settlement from a displacement probe;
-//   - the benchmark history of the nightlies, from GET /v1/benchmarks where the server has it.
+// and, on a page of its own (#/benchmarks), the benchmark history of the nightlies, from
+// GET /v1/benchmarks where the server has it.
 import { get } from './api.js';
 import { h, clear } from './dom.js';
 import { chart } from './chart.js';
@@ -92,8 +93,8 @@ function footing(section, c, probes, charts) {
 
 // The nightlies' figures over time, when the server keeps them (GET /v1/benchmarks: an array of
 // {name, unit, points: [{at, value}]}); a server without that route says so.
-export async function benchmarks(section, charts) {
-  section.append(h('h2', {}, 'Benchmark history'));
+async function benchmarks(section, charts) {
+  section.append(h('h2', {}, 'Benchmark history of the nightlies'));
   let list;
   try {
     list = await get('/v1/benchmarks');
@@ -126,8 +127,14 @@ export async function render(root, { id }) {
     section.append(h('p', { class: 'error' }, e.message));
   }
   if (!any) section.append(h('p', { class: 'muted', id: 'plots-none' }, index ? 'This job is no consolidation column, slope or footing: see its probes on the job page and its fields in the viewer.' : 'No frames yet.'));
-  const bench = h('section', { class: 'card', id: 'benchmarks' });
-  root.append(bench);
-  benchmarks(bench, charts);
   return () => { for (const list of Object.values(charts)) for (const ch of list || []) ch && ch.destroy(); };
+}
+
+// The benchmarks page (#/benchmarks): the nightlies' history.
+export function renderBenchmarks(root) {
+  const charts = { other: [] };
+  const section = h('section', { class: 'card', id: 'benchmarks' });
+  root.append(h('h1', {}, 'Benchmarks'), section);
+  benchmarks(section, charts);
+  return () => { for (const ch of charts.other) ch && ch.destroy(); };
 }
