@@ -528,7 +528,9 @@ static enum poro_status write_probes(FILE *f, struct results *res, const struct 
 }
 
 /* probes RESULT.h5: the whole document, or nothing (an --out FILE is removed) when the file cannot be
- * read. The case comes from the file itself, so its probe order is the run's. */
+ * read. The case comes from the file itself, so its probe order is the run's. FILE is written as
+ * FILE.tmp and renamed, so it is whole whenever it exists: a worker that had to kill this process
+ * while it wrote the frames after it still has complete probes. */
 static int cmd_probes(const char *path, long long job, long long attempt, const char *out, const char *frames)
 {
 	struct poro_error err = {0};
@@ -540,7 +542,10 @@ static int cmd_probes(const char *path, long long job, long long attempt, const 
 	if (!st)
 		st = case_load_string(results_case_json(res), &c, &err);
 	FILE *f = NULL;
-	if (!st && !(f = out ? create_output(out) : stdout)) {
+	char tmp[4200] = "";
+	if (out)
+		snprintf(tmp, sizeof tmp, "%s.tmp", out);
+	if (!st && !(f = out ? create_output(tmp) : stdout)) {
 		results_close(&res);
 		case_destroy(&c);
 		return poro_status_exit_code(PORO_EIO);
@@ -553,9 +558,11 @@ static int cmd_probes(const char *path, long long job, long long attempt, const 
 			st = poro_error_set(&err, PORO_EIO, "cannot write '%s': %s", out ? out : "stdout", strerror(errno));
 	}
 	if (out && f && fclose(f) != 0 && !st)
-		st = poro_error_set(&err, PORO_EIO, "cannot write '%s': %s", out, strerror(errno));
+		st = poro_error_set(&err, PORO_EIO, "cannot write '%s': %s", tmp, strerror(errno));
+	if (!st && out && f && rename(tmp, out) != 0)
+		st = poro_error_set(&err, PORO_EIO, "cannot rename '%s' to '%s': %s", tmp, out, strerror(errno));
 	if (st && out && f)
-		remove(out);
+		remove(tmp);
 	results_close(&res);
 	case_destroy(&c);
 	if (st)
@@ -580,8 +587,8 @@ static int parse_count(const char *key, const char *text, long long *value)
 	return 0;
 }
 
-/* The options of probes and frames: --job, --attempt, --out and (probes) --frames; 0, or an exit
- * status after saying why. */
+/* The options of probes and frames: --job, --attempt, --out and (probes) --frames; 0, -1 after
+ * printing the help (exit 0), or an exit status after saying why. */
 struct extract_options {
 	long long job, attempt;
 	const char *out, *frames;
@@ -598,7 +605,7 @@ static int parse_extract(const struct subcommand *self, int argc, char **argv, i
 	int c;
 	while ((c = getopt_long(argc, argv, "ho:", opts, NULL)) != -1) {
 		if (c == 'h')
-			return subcommand_help(PROGRAM, self);
+			return subcommand_help(PROGRAM, self) == 0 ? -1 : 2;
 		else if (c == 'o')
 			o->out = optarg;
 		else if (c == 'f' && with_frames)
@@ -618,7 +625,7 @@ static int parse_probes(const struct subcommand *self, int argc, char **argv)
 	struct extract_options o = { -1, -1, NULL, NULL };
 	int rc = parse_extract(self, argc, argv, 1, &o);
 	if (rc)
-		return rc;
+		return rc < 0 ? 0 : rc;
 	if (o.job < 0 || o.attempt < 0)
 		return subcommand_usage_error(PROGRAM, self, "missing %s", o.job < 0 ? "--job ID" : "--attempt N");
 	return cmd_probes(argv[optind], o.job, o.attempt, o.out, o.frames);
@@ -630,7 +637,7 @@ static int parse_frames(const struct subcommand *self, int argc, char **argv)
 	struct extract_options o = { 0, 0, NULL, NULL };
 	int rc = parse_extract(self, argc, argv, 0, &o);
 	if (rc)
-		return rc;
+		return rc < 0 ? 0 : rc;
 	if (!o.out)
 		return subcommand_usage_error(PROGRAM, self, "missing --out DIR");
 	struct poro_error err = { 0 };

@@ -288,6 +288,12 @@ static enum probes_state collect_probes(struct job *j, struct staged *f, double 
 		}
 	}
 	if (st == PROBES_FAILED) {
+		snprintf(f->path, sizeof f->path, "%s/%s", j->dir, PROBES_OUT);
+		if (digest_file_hex(f->path, f->sha256, &f->size) == 0) {   /* whole (probes.h): the frames failed */
+			worker_say("%s: no frames for this result.h5: %s", j->tag, why);
+			f->pending = 1;
+			return PROBES_DONE;
+		}
 		worker_say("%s: no probes.json for this result.h5: %s", j->tag, why);
 		if (note)
 			snprintf(note, note_size, "no probes.json: %s", why);

@@ -67,6 +67,14 @@ int probes_start(struct probes_run *p, const char *dir, const char *result, long
 	probes_stop(p);
 	p->message_len = 0;
 	p->message[0] = '\0';
+	/* what an earlier extraction left must not pass for this one's (probes_poll's callers stage
+	 * what is there after a failure too) */
+	static const char *const outputs[] = { PROBES_OUT, PROBES_FRAMES_BIN, PROBES_FRAMES_INDEX };
+	for (size_t i = 0; i < sizeof outputs / sizeof *outputs; i++) {
+		char path[4400];
+		snprintf(path, sizeof path, "%s/%s", dir, outputs[i]);
+		unlink(path);
+	}
 	char job[32], attempt_text[32];
 	snprintf(job, sizeof job, "%lld", id);
 	snprintf(attempt_text, sizeof attempt_text, "%d", attempt);
