@@ -22,7 +22,7 @@ PKGS    = jansson hdf5
 CPPFLAGS = -D_POSIX_C_SOURCE=200809L -DPORO_VERSION=\"$(VERSION)\" $(addprefix -I,$(SOLVER_DIRS)) -I/usr/include/suitesparse $(shell pkg-config --cflags $(PKGS) 2>/dev/null)
 VERSION := $(shell git describe --always --dirty --tags 2>/dev/null || echo unknown)
 CFLAGS  = -std=c11 $(OPT) -g -fopenmp $(WARN) $(SANFLAGS)
-LDLIBS  = $(shell pkg-config --libs $(PKGS) 2>/dev/null) -lcholmod -lm
+LDLIBS  = $(shell pkg-config --libs $(PKGS) 2>/dev/null) -lumfpack -lcholmod -lm
 LDFLAGS = -fopenmp $(SANFLAGS)
 
 # One line per file unless V=1: $(call quiet,CC) before a command prints "  CC      TARGET" and

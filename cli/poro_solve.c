@@ -12,9 +12,9 @@
  *                     [--line X0,Y0,X1,Y1[,...][,N] --line-out FILE [--at TIME]]
  *                                        derived quantities of a run (report.h, docs/report.md): a
  *                                        CSV row per frame (toe, run-out, crest settlement, soil-water
- *                                        gap, oscillation index) to stdout or FILE, and the pore
- *                                        pressure along a line at the frame nearest TIME (default the
- *                                        last) to the --line-out FILE
+ *                                        gap, oscillation index, pressure pattern index) to stdout
+ *                                        or FILE, and the pore pressure along a line at the frame
+ *                                        nearest TIME (default the last) to the --line-out FILE
  *   poro-solve probes RESULT.h5 --job ID --attempt N [--out FILE]
  *                                        the probe series of a run as the JSON document the job
  *                                        service serves (docs/service.md §3, GET .../probes):
@@ -105,8 +105,9 @@ static const struct subcommand COMMANDS[] = {
 	{ "report", "report RESULT.h5 [--out FILE] [--ground Y] [--crest X] [--tolerance M]\n"
 		    "                         [--line X0,Y0,X1,Y1[,...][,N] --line-out FILE [--at TIME]]",
 	  "Derived quantities of a run (docs/report.md): a CSV row per frame (toe, run-out, crest\n"
-	  "settlement, soil-water gap, oscillation index) to stdout or FILE, and the pore pressure along\n"
-	  "a line at the frame nearest TIME (default the last) to the --line-out FILE.\n"
+	  "settlement, soil-water gap, oscillation index, pressure pattern index) to stdout or FILE, and\n"
+	  "the pore pressure along a line at the frame nearest TIME (default the last) to the --line-out\n"
+	  "FILE.\n"
 	  "  -o, --out FILE                the per-frame table (default stdout)\n"
 	  "      --ground Y, --crest X, --tolerance M   the report's settings, m\n"
 	  "      --line X0,Y0,X1,Y1[,...][,N]           a polyline and its number of samples\n"
@@ -156,8 +157,11 @@ static void print_progress(const struct sim_progress *p, void *user)
 		fflush(stdout);
 		return;
 	}
-	printf("step %ld/%ld  t = %.6g s  wall = %.2f s  %.3f us per material-point step\n", p->step,
+	printf("step %ld/%ld  t = %.6g s  wall = %.2f s  %.3f us per material-point step", p->step,
 	       p->steps_total, p->time, p->wall_seconds, p->us_per_point_step);
+	if (p->iterations_mean > 0.0)   /* after the figures the worker reads (worker/log_pump.c) */
+		printf("  Newton iterations %d (mean %.2f)", p->iterations_last, p->iterations_mean);
+	printf("\n");
 	fflush(stdout);
 }
 

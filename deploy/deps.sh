@@ -17,6 +17,8 @@ packages=(
   libcurl4-openssl-dev  # worker and CLI HTTP client
   python3               # test harness helpers
   python3-matplotlib python3-h5py  # poro-plot: pictures of a run from its result.h5
+  python3-jsonschema    # tests/cli/schema_test.sh: the case schemas against the solver's loader
+                        # (Debian 12's 4.10 knows JSON Schema draft 2020-12)
   python3-paraview      # ParaView's own XDMF readers, which tests/cli/paraview_test.sh opens
                         # result.xdmf with (no display needed: readers only)
   curl procps           # the service tests speak HTTP with curl and find processes with pgrep

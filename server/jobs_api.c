@@ -10,7 +10,10 @@
  * the total). The case is stored in canonical form (json_dumps with JSON_COMPACT |
  * JSON_SORT_KEYS: the loader's c->json), and case_sha256 is the SHA-256 of that text. The
  * idempotency comparison uses the SHA-256 of the whole request in the same canonical form, so key
- * order and white space do not make two identical requests differ.
+ * order and white space do not make two identical requests differ. A valid case's warnings (values
+ * the loader allows but that are most likely not what was meant, case.h) are answered with the
+ * job, as "warnings" [{"field", "message"}] beside the 201 or 200, so that a user who submits over
+ * HTTP learns what `poro-solve validate` would have printed; they are not stored.
  */
 #define _DEFAULT_SOURCE /* timegm */
 #include "api.h"
@@ -34,8 +37,9 @@
 #define LIST_LIMIT_DEFAULT 100
 #define ID_MAX 999999999999999999LL
 
-/* Turns the loader's "pointer: message" lines into problems under /case; the loader's last line
- * "... and N more problems" is not a problem of its own (the total is case_problem_count's). */
+/* Turns the loader's "pointer: message" lines (its problems, or a valid case's warnings) into
+ * [{"field": "/case<pointer>", "message"}]; the loader's last line "... and N more problems" is not
+ * a problem of its own (the total is case_problem_count's). */
 static json_t *case_problems(const char *message)
 {
 	json_t *problems = json_array();
@@ -140,6 +144,7 @@ struct submission {
 	char *canonical;                 /* the case in canonical form, owned */
 	char *name;                      /* owned, or NULL */
 	char *title;                     /* the case's title, owned, or NULL */
+	json_t *warnings;                /* the case's warnings as [{field, message}], owned */
 	const char *key;                 /* the Idempotency-Key header, or NULL */
 	long long priority, threads, wall;
 	char case_sha[DIGEST_HEX_SIZE], body_sha[DIGEST_HEX_SIZE];
@@ -150,6 +155,7 @@ static void submission_release(struct submission *s)
 	free(s->canonical);
 	free(s->name);
 	free(s->title);
+	json_decref(s->warnings);
 }
 
 /* The costly part of a submission: parses the body, checks the request and validates the case,
@@ -179,11 +185,12 @@ static int submission_check(struct request *r, struct submission *s)
 		goto done;
 	whole = json_dumps(body, JSON_COMPACT | JSON_SORT_KEYS);
 	s->name = name ? strdup(name) : NULL;
-	if (!whole || (name && !s->name)) {
+	s->warnings = case_problems(loaded->warnings);
+	s->title = loaded->title[0] ? strdup(loaded->title) : NULL;
+	if (!whole || (name && !s->name) || !s->warnings || (loaded->title[0] && !s->title)) {
 		reply_fail(r, API_UNAVAILABLE, "", "no memory to store the case: retry later");
 		goto done;
 	}
-	s->title = loaded->title[0] ? strdup(loaded->title) : NULL;
 	s->canonical = loaded->json; /* taken from the loaded case, which is freed below */
 	loaded->json = NULL;
 	digest_hex(s->canonical, strlen(s->canonical), s->case_sha);
@@ -227,6 +234,8 @@ void jobs_submit(struct request *r)
 		snprintf(location, sizeof location, "/v1/jobs/%lld",
 			 (long long)json_integer_value(json_object_get(job, "id")));
 		reply_header(r, "Location", location);
+		json_object_set_new(job, "warnings", s.warnings);   /* the answer's, not stored */
+		s.warnings = NULL;
 		reply_json(r, created ? 201 : 200, job);
 	}
 	submission_release(&s);
@@ -234,7 +243,7 @@ void jobs_submit(struct request *r)
 
 /* POST /v1/cases/validate: the checks of a submission, nothing stored (docs/web.md, "Submit"). The
  * body is what POST /v1/jobs takes, so its problems name the same fields (/case/...); a valid one
- * answers 200 with the case's title and the SHA-256 its job would get. */
+ * answers 200 with the case's title, the SHA-256 its job would get and the case's warnings. */
 void jobs_validate(struct request *r)
 {
 	struct submission s = { 0 };
@@ -242,9 +251,10 @@ void jobs_validate(struct request *r)
 		return;
 	int checked = submission_check(r, &s) == 0;
 	http_submission_leave(r);
-	if (checked)
-		reply_json(r, 200, json_pack("{s:b, s:s, s:o}", "valid", 1, "case_sha256", s.case_sha, "title",
-					     s.title ? json_string(s.title) : json_null()));
+	if (checked) {
+		reply_json(r, 200, json_pack("{s:b, s:s, s:o, s:O}", "valid", 1, "case_sha256", s.case_sha, "title",
+					     s.title ? json_string(s.title) : json_null(), "warnings", s.warnings));
+	}
 	submission_release(&s);
 }
 

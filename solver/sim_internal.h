@@ -28,6 +28,8 @@ struct sim {
 	struct grid_fields f;
 	struct particles soil, water;
 	int double_point;
+	idx_t saturated_soil;         /* the first this many soil points belong to saturated bodies, the
+					 rest to dry ones ("saturated": false; sim.c seeds them so) */
 	struct material *materials;   /* [case material_count] */
 	const struct scheme *scheme;  /* formulation.scheme's step (scheme.h) */
 	void *scheme_state;           /* the scheme's own state, which its create allocates */

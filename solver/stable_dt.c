@@ -21,8 +21,9 @@
  * The modulus is the elastic constrained modulus E (1 - nu) / ((1 + nu)(1 - 2 nu)) for the models
  * that take E and nu. Nor-Sand's bulk modulus p / kappa grows with the mean effective stress
  * (material_nor_sand.c), which is not known before the run; it is estimated at the largest
- * pressure gravity alone gives the body, the buoyant weight of its full height, p = (1 - n0)
- * (rho_s - rho_w) |g| H (K0 = 1, an upper bound for a column at rest), and never below the
+ * pressure gravity alone gives the body, the effective weight of its full height, p = (1 - n0)
+ * (rho_s - rho_w) |g| H (K0 = 1, an upper bound for a column at rest; without rho_w for a dry
+ * body), and never below the
  * pressure of a point that starts stress free (initial_reference_pressure). Loads on top of it
  * are not counted.
  */
@@ -33,6 +34,13 @@
 
 #include "permeability.h"   /* CONDUCTIVITY_GRAVITY */
 
+double stable_dt_effective_density(const struct case_spec *c, int i)
+{
+	const struct case_body *b = &c->bodies[i];
+	const double rho_w = b->saturated ? c->fluid.density : 0.0;
+	return (1.0 - b->porosity) * (c->materials[b->material].density - rho_w);
+}
+
 double stable_dt_modulus(const struct case_spec *c, int i)
 {
 	const struct case_body *b = &c->bodies[i];
@@ -40,8 +48,8 @@ double stable_dt_modulus(const struct case_spec *c, int i)
 	if (m->model == MODEL_NOR_SAND) {
 		const double g = hypot(c->gravity.acceleration[0], c->gravity.acceleration[1]);
 		const double height = b->max[1] - b->min[1];
-		const double buoyant = (1.0 - b->porosity) * (m->density - c->fluid.density);
-		const double p = fmax(m->initial_reference_pressure, fmax(buoyant, 0.0) * g * height);
+		const double effective = stable_dt_effective_density(c, i);
+		const double p = fmax(m->initial_reference_pressure, fmax(effective, 0.0) * g * height);
 		return p / m->swelling_index + 4.0 / 3.0 * m->shear_modulus;
 	}
 	const double E = m->youngs_modulus, nu = m->poisson_ratio;
@@ -91,6 +99,8 @@ void stable_dt_estimate(const struct case_spec *c, struct stable_dt *out)
 {
 	*out = (struct stable_dt){ .scheme = c->formulation.scheme, .cfl = INFINITY, .wave_step = INFINITY,
 				   .drag_step = INFINITY, .body = -1, .drag_body = -1 };
+	if (c->formulation.scheme == SCHEME_IMPLICIT_UPU)
+		return;   /* Newmark's average acceleration: stable at any step (stable_dt.h) */
 	for (int i = 0; i < c->body_count; i++) {
 		double drag_step = INFINITY;
 		const struct stable_dt e = c->formulation.scheme == SCHEME_EXPLICIT ? coupled_step(c, i, &drag_step)

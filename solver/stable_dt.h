@@ -14,6 +14,10 @@
  * d(v_s - v_f)/dt = -lambda (v_s - v_f) is stable for lambda dt < 2, lambda = c_d (1 / rhō_s +
  * 1 / rhō_f), c_d = n^2 rho_f g / k (Eq. 12). The implicit nodal drag (the default) has no such bound.
  *
+ * Implicit u-p-U (paper 001): Newmark's average acceleration (beta = 1/4, gamma = 1/2, or any pair
+ * the loader accepts) is unconditionally stable for linear problems: no bound (body -1), dt is the
+ * user's choice by accuracy, and "auto" is refused.
+ *
  * case_load.c refuses a case whose dt exceeds stable_dt_max, names the bound with
  * stable_dt_describe, and takes stable_dt_recommended for "dt": "auto"; sim.c keeps the estimate
  * to quote it when a step fails (step_health.c).
@@ -63,6 +67,11 @@ double stable_dt_modulus(const struct case_spec *c, int i);
  * grain density rho_s, porosity n, with pore fluid of density rho_f and bulk modulus K_f: the
  * larger root of the no-drag plane-wave problem of 002 Eqs. 9, 16-17 (spec-002 §5.1). */
 double stable_dt_fast_wave_speed(double M, double rho_s, double n, double rho_f, double K_f);
+
+/* The mass per volume of body i whose weight its skeleton carries, kg/m^3: the buoyant
+ * (1 - n0)(rho_s - rho_w) of a saturated body, the dry (1 - n0) rho_s of a dry one
+ * ("saturated": false). */
+double stable_dt_effective_density(const struct case_spec *c, int i);
 
 /* The largest dt the loader accepts, and the dt that "auto" takes. */
 double stable_dt_max(const struct stable_dt *e);

@@ -46,8 +46,7 @@ double step_health_load_strain(const struct case_spec *c, int *body)
 	const double g = hypot(c->gravity.acceleration[0], c->gravity.acceleration[1]);
 	for (int i = 0; i < c->body_count; i++) {
 		const struct case_body *b = &c->bodies[i];
-		const double buoyant = (1.0 - b->porosity) * (c->materials[b->material].density - c->fluid.density);
-		double stress = fabs(buoyant) * g * (b->max[1] - b->min[1]);
+		double stress = fabs(stable_dt_effective_density(c, i)) * g * (b->max[1] - b->min[1]);
 		for (int l = 0; l < c->load_count; l++)
 			if (c->loads[l].body == i)
 				stress += hypot(c->loads[l].traction[0], c->loads[l].traction[1]) *

@@ -24,8 +24,8 @@
 #define STEP_HEALTH_EXPLICIT_DT_SUSPECT 0.8
 
 /* The largest elastic strain the case's loads and gravity alone give a body: (the peak traction on
- * it + its buoyant weight over its height) / its constrained modulus; *body its index (-1: none).
- * An estimate from the parameters alone, for naming a material too soft for its load. */
+ * it + its effective weight, buoyant or dry, over its height) / its constrained modulus; *body its
+ * index (-1: none). An estimate from the parameters alone, for naming a material too soft for its load. */
 double step_health_load_strain(const struct case_spec *c, int *body);
 
 /* Appends the likely cause to s->err after a failed step. */

@@ -26,7 +26,9 @@
  * Each sits orders of magnitude above the largest case in tests/cases/ and near or beyond what a
  * run could hold in memory, so it refuses only cases that could not run anyway. */
 #define CASE_NAME_MAX 64                 /* bytes of a name with its NUL: names are 1 to 63 characters */
-#define CASE_TITLE_MAX 255               /* bytes of the title */
+#define CASE_TITLE_MAX 255               /* characters (Unicode code points) of the title, as JSON
+					    Schema's maxLength counts them */
+#define CASE_TITLE_SIZE (4 * CASE_TITLE_MAX + 1) /* bytes that hold such a title in UTF-8, with its NUL */
 #define CASE_MATERIALS_MAX 1000
 #define CASE_BODIES_MAX 1000
 #define CASE_LOADS_MAX 1000
@@ -50,9 +52,10 @@
  * case_spec.warnings (element_case.warnings), at most this many bytes with the NUL. */
 #define CASE_WARNINGS_SIZE 2048
 
-/* The time-integration schemes (solver/schemes/): paper 000's semi-implicit fractional step and
- * paper 002's explicit single-point v-w scheme with compressible pore fluid. */
-enum case_scheme { SCHEME_SEMI_IMPLICIT, SCHEME_EXPLICIT };
+/* The time-integration schemes (solver/schemes/): paper 000's semi-implicit fractional step,
+ * paper 002's explicit single-point v-w scheme with compressible pore fluid, and paper 001's fully
+ * implicit u-p-U scheme (Newmark, modified Newton-Raphson). */
+enum case_scheme { SCHEME_SEMI_IMPLICIT, SCHEME_EXPLICIT, SCHEME_IMPLICIT_UPU };
 enum case_phases { PHASES_DOUBLE_POINT, PHASES_SINGLE_POINT };
 enum case_shape { SHAPE_LINEAR, SHAPE_QUADRATIC_BSPLINE, SHAPE_CUBIC_BSPLINE, SHAPE_GIMP };
 /* The matrix of the pressure solve: the Laplacian of 000 Eq. 61, or the projection G^T M^-1 G
@@ -80,7 +83,15 @@ enum drag_integration { DRAG_IMPLICIT, DRAG_EXPLICIT };
  * averaged elastic Jacobian (Eqs. 82-83; patch 1.5 h for B-splines, the cell for linear); and the
  * same with cell-wise patches on any shape (h_patch = h, the comparison of 000 App. A / Fig. 12). */
 enum soil_stabilisation { STABILISATION_NONE, STABILISATION_FBAR, STABILISATION_MODIFIED_FBAR,
-			  STABILISATION_MODIFIED_FBAR_CELLWISE };
+			  STABILISATION_MODIFIED_FBAR_CELLWISE, STABILISATION_BBAR };
+/* The implicit u-p-U scheme's (001 §2.2, spec-001): how the pore-pressure increments reach the
+ * points (the MLSA patch recovery's linear patch at the point, the recovered nodal values
+ * interpolated, or Eq. 11e's direct interpolation), the mass matrices (consistent, A.1a-b as
+ * printed, or lumped), and the Newton iteration's tangent (the elastic one factorised once a step,
+ * 001's modified Newton-Raphson, or the materials' consistent tangent every iteration). */
+enum pressure_recovery { PRESSURE_RECOVERY_MLSA_PATCH, PRESSURE_RECOVERY_MLSA_NODAL, PRESSURE_RECOVERY_NONE };
+enum mass_matrix { MASS_MATRIX_CONSISTENT, MASS_MATRIX_LUMPED };
+enum newton_tangent { NEWTON_TANGENT_ELASTIC, NEWTON_TANGENT_CONSISTENT };
 
 /* Constitutive models (material.h), one file each: "linear_elastic" (small strain), "hencky" (finite
  * strain), the Mohr-Coulomb family returned in principal stress space (principal_return.h):
@@ -146,6 +157,13 @@ struct case_formulation {
 	enum pressure_rate_projection pressure_rate_projection; /* "multi_field" (default) or "none" */
 	enum pressure_rate_basis pressure_rate_basis;       /* "constant" (default) or "linear" */
 	enum drag_integration drag;                         /* "implicit" (default) or "explicit" */
+	/* the implicit u-p-U scheme's (001, spec-001 §4); soil_stabilisation "bbar" (default) or "none" */
+	double newmark_beta, newmark_gamma;                 /* 0.25, 0.5 (001 §2.2) */
+	enum newton_tangent tangent;                        /* "elastic" (default) or "consistent" */
+	double newton_tolerance;                            /* energy criterion, default 1e-10 */
+	int newton_max_iterations;                          /* default 100 */
+	enum pressure_recovery pressure_recovery;           /* "mlsa_patch" (default), "mlsa_nodal", "none" */
+	enum mass_matrix mass_matrix;                       /* "consistent" (default) or "lumped" */
 };
 
 struct case_grid {
@@ -211,6 +229,8 @@ struct case_body {
 						   (k = k0 (V/V0)^2, Xie and Leo 2004) */
 	double initial_pore_pressure;     /* Pa, compression positive, default 0: the points' pore
 					     pressure at t = 0 (002 §4.1 starts at p0 = q with sigma' = 0) */
+	int saturated;                    /* 1 (default): the pores are full of water; 0: a dry body, whose
+					     points carry no water (sim.c, docs/numerics.md "Dry bodies") */
 };
 
 struct case_time_function {
@@ -255,7 +275,7 @@ struct case_probe {
 };
 
 struct case_spec {
-	char title[CASE_TITLE_MAX + 1];
+	char title[CASE_TITLE_SIZE];      /* UTF-8, at most CASE_TITLE_MAX characters */
 	char warnings[CASE_WARNINGS_SIZE]; /* "" when none (CASE_WARNINGS_SIZE) */
 	struct case_formulation formulation;
 	struct case_grid grid;
@@ -270,6 +290,8 @@ struct case_spec {
 		double cavitation_pressure; /* p_cav, the pressure at which the pore water boils, Pa, gauge
 					       (compression positive, as in case files), < 0; 0: no limit,
 					       the water takes any tension as in 000 (cavitation.c) */
+		double grain_bulk_modulus; /* K_s of 001 Eq. 3, Pa: the grains' compressibility in 1/Q =
+					      n / K_w + (1 - n) / K_s; 0 (default): incompressible grains */
 		double cavitated_bulk_modulus; /* K_c, Pa: the stiffness of the water once it has cavitated,
 						  the spring on its vapour (cavitation.c) */
 	} fluid;

@@ -21,7 +21,7 @@ static const struct case_range POSITIVE = { BOUND_OPEN, 0, BOUND_NONE, 0 };
 static const struct case_range FRACTION = { BOUND_CLOSED, 0, BOUND_CLOSED, 1 };
 
 /* Names of enum values, in enum order. */
-static const char *const scheme_names[] = { "semi_implicit", "explicit", NULL };
+static const char *const scheme_names[] = { "semi_implicit", "explicit", "implicit_upU", NULL };
 static const char *const phases_names[] = { "double_point", "single_point", NULL };
 static const char *const shape_names[] = { "linear", "quadratic_bspline", "cubic_bspline", "gimp", NULL };
 static const char *const projection_names[] = { "laplacian", "consistent", NULL };
@@ -36,6 +36,16 @@ static const char *const smoothing_names[] = { "cell_average", "none", NULL };
 static const char *const pressure_rate_names[] = { "multi_field", "none", NULL };
 static const char *const basis_names[] = { "constant", "linear", NULL };
 static const char *const drag_names[] = { "implicit", "explicit", NULL };
+static const char *const bbar_names[] = { "none", "bbar", NULL };
+static const char *const tangent_names[] = { "elastic", "consistent", NULL };
+static const char *const recovery_names[] = { "mlsa_patch", "mlsa_nodal", "none", NULL };
+static const char *const mass_matrix_names[] = { "consistent", "lumped", NULL };
+
+#define DEFAULT_NEWMARK_BETA 0.25
+#define DEFAULT_NEWMARK_GAMMA 0.5
+#define DEFAULT_NEWTON_TOLERANCE 1e-10      /* |delta . r| against the first iteration's (spec-001 §4.2) */
+#define DEFAULT_NEWTON_MAX_ITERATIONS 100
+#define NEWTON_MAX_ITERATIONS_LIMIT 10000
 
 /* The keys each scheme takes beside those every scheme takes, in scheme order. */
 static const char *const common_keys[] = { "scheme", "phases", "shape", "flip_fraction", "velocity_update",
@@ -46,8 +56,10 @@ static const char *const *const scheme_keys[] = {
 			       "free_surface", "free_surface_penalty_factor", "position_update", NULL },
 	(const char *const[]){ "strain_rate_smoothing", "pressure_rate_projection", "pressure_rate_basis", "drag",
 			       NULL },
+	(const char *const[]){ "soil_stabilisation", "newmark_beta", "newmark_gamma", "tangent", "newton_tolerance",
+			       "newton_max_iterations", "pressure_recovery", "mass_matrix", NULL },
 };
-#define SCHEME_COUNT 2
+#define SCHEME_COUNT 3
 
 void case_formulation_defaults(struct case_formulation *f)
 {
@@ -68,6 +80,13 @@ void case_formulation_defaults(struct case_formulation *f)
 	f->pressure_rate_projection = PRESSURE_RATE_MULTI_FIELD;
 	f->pressure_rate_basis = PRESSURE_RATE_BASIS_CONSTANT;
 	f->drag = DRAG_IMPLICIT;
+	f->newmark_beta = DEFAULT_NEWMARK_BETA;
+	f->newmark_gamma = DEFAULT_NEWMARK_GAMMA;
+	f->tangent = NEWTON_TANGENT_ELASTIC;
+	f->newton_tolerance = DEFAULT_NEWTON_TOLERANCE;
+	f->newton_max_iterations = DEFAULT_NEWTON_MAX_ITERATIONS;
+	f->pressure_recovery = PRESSURE_RECOVERY_MLSA_PATCH;
+	f->mass_matrix = MASS_MATRIX_CONSISTENT;
 }
 
 /* A choice read into an enum: the chosen index, or fallback when absent or invalid. */
@@ -159,6 +178,44 @@ static void read_explicit(struct case_reader *r, const json_t *o, const char *p,
 	f->drag = choice_or(r, o, p, "drag", CASE_OPTIONAL, drag_names, f->drag);
 }
 
+/* 001's Newmark parameters, kept where the average-acceleration family is unconditionally stable
+ * for linear problems: gamma >= 1/2 and beta >= (gamma + 1/2)^2 / 4. */
+static void read_implicit(struct case_reader *r, const json_t *o, const char *p, struct case_formulation *f)
+{
+	static const struct case_range POSITIVE_FRACTION = { BOUND_OPEN, 0, BOUND_CLOSED, 1 };
+	static const struct case_range TOLERANCE = { BOUND_OPEN, 0, BOUND_OPEN, 1 };
+	if (f->phases != PHASES_SINGLE_POINT)
+		case_problem(r, "/formulation/phases", "the \"implicit_upU\" scheme is single point (001 §2): must be "
+			     "\"single_point\", got \"%s\"", phases_names[f->phases]);
+	/* the points' velocities follow Newmark's trapezoid on their accelerations (001 Eq. 11c) */
+	if (f->velocity_update != VELOCITY_UPDATE_FLIP)
+		case_problem(r, "/formulation/velocity_update", "the \"implicit_upU\" scheme moves its points' velocities "
+			     "by Newmark (001 Eq. 11c): leave it out or \"flip\"");
+	if (f->flip_fraction != 1)
+		case_problem(r, "/formulation/flip_fraction", "the \"implicit_upU\" scheme moves its points' velocities by "
+			     "Newmark (001 Eq. 11c), not FLIP blended with PIC: leave it out or 1");
+	int bbar = 1;
+	case_read_choice(r, o, p, "soil_stabilisation", CASE_OPTIONAL, bbar_names, &bbar);
+	f->soil_stabilisation = bbar ? STABILISATION_BBAR : STABILISATION_NONE;
+	/* the cell-centre sampling of 001 Eqs. 15-16 is written for uGIMP's domains */
+	if (bbar && f->shape != SHAPE_GIMP)
+		case_problem(r, "/formulation/soil_stabilisation", "\"bbar\" samples uGIMP at the cell centres "
+			     "(001 Eqs. 12-16): needs /formulation/shape \"gimp\"");
+	case_read_number(r, o, p, "newmark_gamma", CASE_OPTIONAL, &POSITIVE_FRACTION, &f->newmark_gamma);
+	case_read_number(r, o, p, "newmark_beta", CASE_OPTIONAL, &POSITIVE_FRACTION, &f->newmark_beta);
+	const double beta_min = 0.25 * (f->newmark_gamma + 0.5) * (f->newmark_gamma + 0.5);
+	if (f->newmark_gamma < 0.5 || f->newmark_beta < beta_min - 1e-12)
+		case_problem(r, "/formulation/newmark_beta", "with newmark_gamma %g must be at least %g (and gamma at "
+			     "least 1/2) for the step to be stable at any dt", f->newmark_gamma, beta_min);
+	f->tangent = choice_or(r, o, p, "tangent", CASE_OPTIONAL, tangent_names, f->tangent);
+	case_read_number(r, o, p, "newton_tolerance", CASE_OPTIONAL, &TOLERANCE, &f->newton_tolerance);
+	case_read_int(r, o, p, "newton_max_iterations", CASE_OPTIONAL, 1, NEWTON_MAX_ITERATIONS_LIMIT,
+		      &f->newton_max_iterations);
+	f->pressure_recovery = choice_or(r, o, p, "pressure_recovery", CASE_OPTIONAL, recovery_names,
+					 f->pressure_recovery);
+	f->mass_matrix = choice_or(r, o, p, "mass_matrix", CASE_OPTIONAL, mass_matrix_names, f->mass_matrix);
+}
+
 void case_read_formulation(struct case_reader *r, const json_t *root, struct case_formulation *f)
 {
 	const char *p = "/formulation";
@@ -170,6 +227,9 @@ void case_read_formulation(struct case_reader *r, const json_t *root, struct cas
 	if (scheme >= 0)
 		f->scheme = scheme;
 	check_formulation_keys(r, o, f->scheme);
+	/* Only paper 000's scheme has a double-point form: the others default to the one they take. */
+	if (f->scheme != SCHEME_SEMI_IMPLICIT)
+		f->phases = PHASES_SINGLE_POINT;
 	f->phases = choice_or(r, o, p, "phases", CASE_OPTIONAL, phases_names, f->phases);
 	f->shape = choice_or(r, o, p, "shape", CASE_OPTIONAL, shape_names, f->shape);
 	case_read_number(r, o, p, "flip_fraction", CASE_OPTIONAL, &FRACTION, &f->flip_fraction);
@@ -184,20 +244,41 @@ void case_read_formulation(struct case_reader *r, const json_t *root, struct cas
 		return;   /* the scheme's own keys were refused above as unknown to it */
 	if (f->scheme == SCHEME_EXPLICIT)
 		read_explicit(r, o, p, f);
+	else if (f->scheme == SCHEME_IMPLICIT_UPU)
+		read_implicit(r, o, p, f);
 	else
 		read_semi_implicit(r, o, p, f);
 }
 
 void case_check_scheme(struct case_reader *r, const struct case_spec *c)
 {
-	if (c->formulation.scheme != SCHEME_EXPLICIT)
+	if (c->formulation.scheme == SCHEME_SEMI_IMPLICIT) {
+		if (c->fluid.grain_bulk_modulus > 0)
+			case_problem(r, "/fluid/grain_bulk_modulus", "applies to the \"implicit_upU\" scheme only");
 		return;
+	}
+	const char *scheme = scheme_names[c->formulation.scheme];
+	/* the small-strain tangent d sigma / d eps is the Jacobian of the scheme's residual (spec-001
+	 * §3.4: linearised strain at x_n); a finite-strain model's d tau / d ln Be_trial is not */
+	if (c->formulation.scheme == SCHEME_IMPLICIT_UPU && c->formulation.tangent == NEWTON_TANGENT_CONSISTENT)
+		for (int m = 0; m < c->material_count; m++) {
+			const struct case_material *mat = &c->materials[m];
+			if (mat->model == MODEL_LINEAR_ELASTIC || (mat->model != MODEL_HENCKY && mat->strain == STRAIN_SMALL))
+				continue;
+			char pointer[CASE_POINTER_MAX];
+			case_pointer_index(pointer, "/materials", (size_t)m);
+			case_problem(r, pointer, "material '%s' is finite strain: /formulation/tangent \"consistent\" takes "
+				     "small-strain materials (\"linear_elastic\", or \"strain\": \"small\"), whose tangent is the "
+				     "Jacobian of the implicit_upU scheme's linearised strain", mat->name);
+		}
 	static const char *const face_names[] = { "left", "right", "bottom", "top" };
 	if (c->fluid.cavitation_pressure < 0)
 		case_problem(r, "/fluid/cavitation_pressure", "applies to the \"semi_implicit\" scheme only (the "
-			     "explicit scheme's pore fluid is linearly compressible, 002 Eq. 8)");
+			     "\"%s\" scheme's pore fluid is linearly compressible)", scheme);
 	if (c->gravity.water_attached)
 		case_problem(r, "/gravity/water_attached", "applies to the \"semi_implicit\" scheme only");
+	if (c->fluid.grain_bulk_modulus > 0 && c->formulation.scheme != SCHEME_IMPLICIT_UPU)
+		case_problem(r, "/fluid/grain_bulk_modulus", "applies to the \"implicit_upU\" scheme only");
 	if (c->gravity.loading_conductivity > 0)
 		case_problem(r, "/gravity/loading_conductivity", "applies to the \"semi_implicit\" scheme only");
 	for (int f = 0; f < FACE_COUNT; f++) {
@@ -208,12 +289,12 @@ void case_check_scheme(struct case_reader *r, const struct case_spec *c)
 			case_pointer_key(pointer, face, "soil");
 			case_problem(r, pointer, "\"plate\" applies to the \"semi_implicit\" scheme only");
 		}
-		/* the explicit scheme drains a face through the water's velocity (002 §3.1, natural
-		 * condition P = 0): a drained face whose water is held would pass no water */
+		/* these schemes move the water itself (002 §3.1, 001 Eq. 2): a drained face whose water
+		 * is held would pass no water */
 		if (b->drainage == DRAINAGE_DRAINED && b->water != CONSTRAINT_FREE && b->water != CONSTRAINT_PLATE) {
 			case_pointer_key(pointer, face, "drainage");
 			case_problem(r, pointer, "\"drained\" needs \"water\": \"free\" on this face under the "
-				     "\"explicit\" scheme, which drains a face where its water moves freely");
+				     "\"%s\" scheme, which drains a face where its water moves freely", scheme);
 		}
 	}
 }

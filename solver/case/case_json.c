@@ -427,6 +427,24 @@ int case_read_string(struct case_reader *r, const json_t *obj, const char *base,
 	return read_string_at(r, obj, base, key, need, out, pointer);
 }
 
+int case_read_short_text(struct case_reader *r, const json_t *obj, const char *base, const char *key,
+			 enum case_need need, int max_chars, char *out)
+{
+	char pointer[CASE_POINTER_MAX];
+	const char *s;
+	if (!read_string_at(r, obj, base, key, need, &s, pointer))
+		return 0;
+	long chars = 0;
+	for (const char *c = s; *c; c++)   /* jansson has checked the UTF-8: count the lead bytes */
+		chars += ((unsigned char)*c & 0xc0) != 0x80;
+	if (chars > max_chars) {
+		case_problem(r, pointer, "must be at most %d characters long, got %ld", max_chars, chars);
+		return 0;
+	}
+	memcpy(out, s, strlen(s) + 1);
+	return 1;
+}
+
 int case_read_choice(struct case_reader *r, const json_t *obj, const char *base, const char *key,
 		     enum case_need need, const char *const *names, int *out)
 {

@@ -119,6 +119,11 @@ int case_read_bool(struct case_reader *r, const json_t *obj, const char *base, c
 		   enum case_need need, int *out);
 int case_read_string(struct case_reader *r, const json_t *obj, const char *base, const char *key,
 		     enum case_need need, const char **out);
+/* A string of at most max_chars characters (Unicode code points, as JSON Schema's maxLength counts
+ * them: a byte count would refuse a title of accented letters that the schema accepts), copied into
+ * out[4 max_chars + 1]. */
+int case_read_short_text(struct case_reader *r, const json_t *obj, const char *base, const char *key,
+			 enum case_need need, int max_chars, char *out);
 /* A string that must be one of names (NULL-terminated); *out is its index. */
 int case_read_choice(struct case_reader *r, const json_t *obj, const char *base, const char *key,
 		     enum case_need need, const char *const *names, int *out);

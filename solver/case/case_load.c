@@ -46,7 +46,7 @@
 
 /* Limits. */
 /* Cells per direction: room for the B-splines' edge treatment (shape.h) and the semi-implicit
- * scheme's pressure stencils; uGIMP's support fits in 2, which the explicit scheme takes (002
+ * scheme's pressure stencils; uGIMP's support fits in 2, which the explicit and implicit schemes take (002
  * §4.1's column is 2 cells wide). */
 #define GRID_CELLS_MIN 3
 #define GRID_CELLS_MIN_NARROW 2
@@ -72,16 +72,16 @@ static const char *const probe_field_names[] = { "pore_pressure", "stress_xx", "
 static const char *const component_names[] = { "x", "y", NULL };
 
 /* Keys allowed in each object. */
-static const char *const top_keys[] = { "schema", "title", "formulation", "grid", "materials", "bodies",
+static const char *const top_keys[] = { "$schema", "schema", "title", "formulation", "grid", "materials", "bodies",
 					"fluid", "gravity", "boundaries", "loads", "time", "output",
 					"probes", "checkpoint", NULL };
 static const char *const grid_keys[] = { "origin", "extent", "cell_size", NULL };
 /* A material's own keys; its model's keys are checked by case_read_material_model(). */
 static const char *const material_keys[] = { "name", "density", NULL };
 static const char *const body_keys[] = { "name", "material", "rectangle", "polygon", "particles_per_cell",
-					 "porosity", "hydraulic_conductivity", "permeability_law",
+					 "porosity", "hydraulic_conductivity", "permeability_law", "saturated",
 					 "initial_pore_pressure", NULL };
-static const char *const fluid_keys[] = { "density", "bulk_modulus", "cavitation_pressure",
+static const char *const fluid_keys[] = { "density", "bulk_modulus", "grain_bulk_modulus", "cavitation_pressure",
 					  "cavitated_bulk_modulus", NULL };
 static const char *const gravity_keys[] = { "acceleration", "ramp_time", "elastic_loading", "loading_conductivity",
 						"water_attached", NULL };
@@ -143,15 +143,12 @@ static void check_unique(struct case_reader *r, struct case_names *names, const 
 static void read_header(struct case_reader *r, const json_t *root, struct case_spec *c)
 {
 	int version;
-	const char *title;
+	const char *schema_location;
+	/* "$schema" names the JSON Schema for editors (VS Code and others validate and complete
+	 * against it); the solver only checks that it is a string */
+	case_read_string(r, root, "", "$schema", CASE_OPTIONAL, &schema_location);
 	case_read_choice(r, root, "", "schema", CASE_REQUIRED, schema_names, &version);
-	if (!case_read_string(r, root, "", "title", CASE_OPTIONAL, &title))
-		return;
-	size_t length = strlen(title);
-	if (length > CASE_TITLE_MAX)
-		case_problem(r, "/title", "must be at most %d bytes long, got %zu", CASE_TITLE_MAX, length);
-	else
-		memcpy(c->title, title, length + 1);
+	case_read_short_text(r, root, "", "title", CASE_OPTIONAL, CASE_TITLE_MAX, c->title);
 }
 
 /* Checks that extent[d] is a whole number, at least `least` (GRID_CELLS_MIN...), of cells. */
@@ -186,7 +183,7 @@ static int read_grid(struct case_reader *r, const json_t *root, const struct cas
 	int extent_ok = case_read_vec2(r, o, p, "extent", CASE_REQUIRED, &POSITIVE, g->extent);
 	int cell_size_ok = case_read_number(r, o, p, "cell_size", CASE_REQUIRED, &POSITIVE, &g->cell_size);
 	if (extent_ok && cell_size_ok) {
-		const int least = form->shape == SHAPE_GIMP && form->scheme == SCHEME_EXPLICIT ? GRID_CELLS_MIN_NARROW
+		const int least = form->shape == SHAPE_GIMP && form->scheme != SCHEME_SEMI_IMPLICIT ? GRID_CELLS_MIN_NARROW
 												: GRID_CELLS_MIN;
 		extent_ok &= check_cell_count(r, g, 0, least);
 		extent_ok &= check_cell_count(r, g, 1, least);
@@ -263,6 +260,27 @@ static int read_body(struct case_reader *r, const json_t *o, const char *p, cons
 	b->permeability_law = read_choice_or(r, o, p, "permeability_law", CASE_OPTIONAL,
 					     permeability_law_names, b->permeability_law);
 	case_read_number(r, o, p, "initial_pore_pressure", CASE_OPTIONAL, NULL, &b->initial_pore_pressure);
+	b->saturated = 1;
+	if (case_read_bool(r, o, p, "saturated", CASE_OPTIONAL, &b->saturated) && !b->saturated &&
+	    c->formulation.pressure_projection != PROJECTION_LAPLACIAN) {
+		/* measured with the Laplacian only: the consistent projection's low-permeability options
+		 * diverged on a dry fill (docs/numerics.md, "Dry bodies") */
+		char pointer[CASE_POINTER_MAX];
+		case_pointer_key(pointer, p, "saturated");
+		case_problem(r, pointer, "false needs /formulation/pressure_projection \"laplacian\": a dry body's "
+			     "contact is verified with it alone");
+	}
+	if (!b->saturated && c->formulation.scheme != SCHEME_SEMI_IMPLICIT) {
+		/* the other schemes' single-point water rides on every soil point */
+		char pointer[CASE_POINTER_MAX];
+		case_pointer_key(pointer, p, "saturated");
+		case_problem(r, pointer, "false applies to the \"semi_implicit\" scheme only");
+	}
+	if (!b->saturated && b->initial_pore_pressure != 0.0) {
+		char pointer[CASE_POINTER_MAX];
+		case_pointer_key(pointer, p, "initial_pore_pressure");
+		case_problem(r, pointer, "a dry body (\"saturated\": false) has no pore water to hold a pressure");
+	}
 	return seeded;
 }
 
@@ -304,6 +322,7 @@ static void read_fluid(struct case_reader *r, const json_t *root, struct case_sp
 	case_check_keys(r, o, "/fluid", fluid_keys);
 	case_read_number(r, o, "/fluid", "density", CASE_OPTIONAL, &POSITIVE, &c->fluid.density);
 	case_read_number(r, o, "/fluid", "bulk_modulus", CASE_OPTIONAL, &POSITIVE, &c->fluid.bulk_modulus);
+	case_read_number(r, o, "/fluid", "grain_bulk_modulus", CASE_OPTIONAL, &POSITIVE, &c->fluid.grain_bulk_modulus);
 	case_read_number(r, o, "/fluid", "cavitation_pressure", CASE_OPTIONAL, &NEGATIVE,
 			 &c->fluid.cavitation_pressure);
 	case_read_number(r, o, "/fluid", "cavitated_bulk_modulus", CASE_OPTIONAL, &POSITIVE,
@@ -524,6 +543,11 @@ static int read_time(struct case_reader *r, const json_t *root, struct case_spec
 	int ok = case_read_number_or_word(r, o, "/time", "dt", CASE_REQUIRED, &POSITIVE, "auto", &c->time.dt,
 					  &c->time.dt_auto);
 	ok &= case_read_number(r, o, "/time", "end", CASE_REQUIRED, &POSITIVE, &c->time.end);
+	if (ok && c->time.dt_auto && c->formulation.scheme == SCHEME_IMPLICIT_UPU) {
+		case_problem(r, "/time/dt", "\"auto\" has no meaning for the \"implicit_upU\" scheme, stable at any "
+			     "step: choose dt by the accuracy wanted");
+		return 0;
+	}
 	if (ok && c->time.dt_auto) {
 		/* the scheme's recommended step, known once everything it follows from was read */
 		struct stable_dt e;

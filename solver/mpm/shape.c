@@ -141,6 +141,29 @@ static inline int gimp_1d(double xi, double lambda, idx_t cells, double inv_h, i
 	return 0;
 }
 
+int shape_1d_gimp_cell_centre(double xi, double half_width, idx_t cells, double inv_h, idx_t *i0, double *G,
+			      double *W)
+{
+	if (!(xi >= 0.0 && xi <= (double)cells) || !(half_width > 0.0))
+		return -1;
+	const double a = fmax(xi - half_width, 0.0), b = fmin(xi + half_width, (double)cells), inv_len = 1.0 / (b - a);
+	idx_t i = (idx_t)floor(a);
+	for (int k = 0; k < 3; k++) {
+		const double node = (double)(i + k);
+		const double left = fmax(0.0, fmin(b, node) - fmax(a, node - 1.0));    /* in [node - 1, node] */
+		const double right = fmax(0.0, fmin(b, node + 1.0) - fmax(a, node));   /* in [node, node + 1] */
+		G[k] = (left - right) * inv_len * inv_h;
+		W[k] = (left + right) * inv_len;
+	}
+	if (i > cells - 2) {      /* as gimp_1d: the nodes are the upper two of the three */
+		G[2] = G[1], G[1] = G[0], G[0] = 0.0;
+		W[2] = W[1], W[1] = W[0], W[0] = 0.0;
+		i = cells - 2;
+	}
+	*i0 = i;
+	return 0;
+}
+
 int shape_1d_gimp(double xi, double half_width, idx_t cells, double inv_h, idx_t *i0, double *w, double *dw)
 {
 	if (!(xi >= 0.0 && xi <= (double)cells))
@@ -196,7 +219,7 @@ static inline int evaluate_point(const struct grid *g, enum case_shape kind, con
 	const double eta = (p->x[2 * q + 1] - g->origin[1]) * g->inv_h;
 	if (kind == SHAPE_GIMP) {
 		/* uGIMP: the square domain of the point's initial volume, kept through the motion */
-		const double lambda = fmin(0.5 * sqrt(p->volume0[q]) * g->inv_h, 0.5);   /* one point per cell at most */
+		const double lambda = shape_gimp_half_width(g, p->volume0[q]);
 		if (shape_1d_gimp(xi, lambda, g->cells[0], g->inv_h, &i0, f, f + 2 * S) ||
 		    shape_1d_gimp(eta, lambda, g->cells[1], g->inv_h, &j0, f + S, f + 3 * S))
 			return -1;

@@ -8,6 +8,8 @@ const struct scheme *scheme_of(enum case_scheme kind)
 	switch (kind) {
 	case SCHEME_EXPLICIT:
 		return &explicit_scheme;
+	case SCHEME_IMPLICIT_UPU:
+		return &implicit_upU_scheme;
 	case SCHEME_SEMI_IMPLICIT:
 		break;
 	}

@@ -38,11 +38,17 @@ struct scheme {
 	/* One step from s->time to s->time + dt; advances s->time and s->step, or fails with s->err
 	 * naming what and where. */
 	enum poro_status (*step)(struct sim *s);
+	/* A scheme that iterates within a step reports its iterations (poro.h, sim_iterations);
+	 * NULL for one that does not. */
+	int (*iterations)(const struct sim *s, int *last, long *total, const double **energies, int *count);
+	/* A scheme with a sparse direct solver reports its work (poro.h, sim_linear_solver_counts). */
+	int (*solver_counts)(const struct sim *s, long *analyses, long *factorisations, long *solves,
+			     long *factor_nonzeros);
 };
 
 /* The scheme a case asks for. */
 const struct scheme *scheme_of(enum case_scheme kind);
 
-extern const struct scheme semi_implicit_scheme, explicit_scheme;
+extern const struct scheme semi_implicit_scheme, explicit_scheme, implicit_upU_scheme;
 
 #endif

@@ -52,6 +52,7 @@ cat > "$tmp/want.txt" <<'EOF'
 644 usr/share/poro/examples/poro-server.conf
 644 usr/share/poro/examples/worker.env
 644 usr/share/poro/schemas/case.schema.json
+644 usr/share/poro/schemas/element.schema.json
 644 usr/share/poro/schemas/openapi.yaml
 644 usr/share/poro/schemas/results.md
 EOF

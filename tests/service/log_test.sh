@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# log_test.sh - the server's log (docs/service.md §7): one logfmt line per request and per job
+# log_test.sh - the server's log (docs/service.md §8): one logfmt line per request and per job
 # state change, through one gateway, read back from a real poro-server's stderr.
 #
 # Requests: a few requests of users, a worker and no one (answered 200, 201, 401, 404) each leave a

@@ -16,8 +16,13 @@
  *    velocities then satisfy the weak continuity equation -G^T v = 0 exactly, and the pressure
  *    forces of the predictors use the same G on the nodal pressure, so a pressure error is removed
  *    in one step instead of being fed back (docs/numerics.md has the measurements).
- *    Equal-order B-splines leave a node-to-node pressure pattern nearly outside A's reach; the
- *    case may hold it down with formulation.pressure_stabilisation (pressure_stabilisation.c).
+ *    Equal-order B-splines leave a node-to-node pressure pattern nearly outside A's reach (on a
+ *    regular seeding exactly: G of the alternation vanishes wherever the points are symmetric
+ *    about the nodes, pressure_test), and the solve gives it whatever the near-null ratio of the
+ *    right-hand side to its eigenvalue is, every step afresh: the failing Mohr-Coulomb slopes
+ *    show it as stripes of period two cells (docs/numerics.md, "A pressure pattern of period two
+ *    cells"). The case may hold it down with formulation.pressure_stabilisation
+ *    (pressure_stabilisation.c).
  *
  * Boundary conditions: impermeable faces need nothing (the natural condition of Eq. 32). Where
  * the pressure is zero, on the free water surface and on drained faces, free_surface.c decides,
@@ -190,10 +195,11 @@ void pressure_gradient_operators(struct sim *s)
 	memset(ps->grad_w, 0, sizeof(double) * nodes * gst);
 	/* the two operators are independent, each built by one thread in point order (so the sums
 	 * are the same whatever the thread count): with two threads, one each */
+	const struct particles wet = semi_implicit_wet_soil(s);   /* dry bodies feel no pore pressure */
 	#pragma omp parallel sections
 	{
 		#pragma omp section
-		add_gradient_operator(s, &s->soil, ps->grad_s);
+		add_gradient_operator(s, &wet, ps->grad_s);
 		#pragma omp section
 		add_gradient_operator(s, &s->water, ps->grad_w);
 	}
@@ -355,9 +361,10 @@ void pressure_divergence_rhs(struct sim *s, const double *v_s, const double *v_w
 	struct grid_fields *f = &s->f;
 	const struct grid *g = &s->grid;
 	double *sum_s = si->correction_s, *sum_w = si->correction_w;   /* free until step 6 */
+	const struct particles wet = semi_implicit_wet_soil(s);   /* a dry body's volume change needs no water */
 	memset(sum_s, 0, sizeof(double) * (size_t)g->node_count);
 	memset(sum_w, 0, sizeof(double) * (size_t)g->node_count);
-	p2g_point_divergence(g, &s->soil, s->soil.volume, v_s, sum_s);
+	p2g_point_divergence(g, &wet, wet.volume, v_s, sum_s);
 	p2g_point_divergence(g, &s->water, s->water.volume, v_w, sum_w);
 	for (idx_t I = 0; I < g->node_count; I++)
 		out[I] = ((1.0 - f->porosity[I]) * sum_s[I] + f->porosity[I] * sum_w[I]) / s->dt;
@@ -438,7 +445,7 @@ enum poro_status pressure_solve(struct sim *s)
 {
 	struct semi_implicit *si = semi_implicit_of(s);
 	struct pressure_system *ps = &si->ps;
-	const struct particles *p = &s->soil, *w = &s->water;
+	const struct particles wet = semi_implicit_wet_soil(s), *p = &wet, *w = &s->water;
 	double t0 = sim_clock();
 	memset(ps->stencil, 0, sizeof(double) * (size_t)s->grid.node_count * ps->width * ps->width);
 	double diagonal_mean = 0.0;

@@ -215,8 +215,9 @@ static void correct_velocities(struct sim *s)
 		memset(si->correction_w, 0, 2 * sizeof(double) * (size_t)g->node_count);
 		pressure_apply_gradient(s, si->ps.grad_s, si->dp, si->correction_s);
 		pressure_apply_gradient(s, si->ps.grad_w, si->dp, si->correction_w);
-	} else {
-		p2g_point_gradient(g, &s->soil, s->soil.volume, si->dp, si->correction_s);
+	} else {   /* the pressure pushes the saturated skeleton only (semi_implicit_wet_soil) */
+		const struct particles wet = semi_implicit_wet_soil(s);
+		p2g_point_gradient(g, &wet, wet.volume, si->dp, si->correction_s);
 		p2g_point_gradient(g, &s->water, s->water.volume, si->dp, si->correction_w);
 	}
 	for (idx_t I = 0; I < g->node_count; I++) {
