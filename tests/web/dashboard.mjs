@@ -8,9 +8,11 @@
 //   b. the field viewer draws the last frame (the canvas' colours span the colour bar), its slider
 //      changes the frame; the Terzaghi plot's points are the run's values, as h5py reads them
 //      from the job's result.h5.
-//   c. a bad case shows its JSON pointer error at its field and creates no job; another user's job
+//   c. a bad case, uploaded as a file, shows its JSON pointer error at its field and creates no job; another user's job
 //      is not listed and its page says not found; no token in any URL, the page's HTML, its
 //      console or its storage other than session storage.
+//   5. a short slope's run-out plot is the run's report (poro-solve report on its result.h5), a
+//      short footing's load-settlement plot its settlement probe (h5py) against the ramped load.
 //   e. screenshots of the sign-in, jobs, submit, job, viewer, plots, benchmarks and admin pages.
 import { chromium } from 'playwright-core';
 import { spawn, execFileSync } from 'node:child_process';
@@ -67,6 +69,45 @@ function shortTerzaghi(c) {
   return c;
 }
 
+// A slope (polygon bodies: the run-out plot) and a footing (a load on part of a face: the
+// load-settlement plot), each cut to tens of steps (about a second of one core together).
+function caseFile(name) { return JSON.parse(fs.readFileSync(path.join('tests/cases', name), 'utf8')); }
+function shortSlope() {
+  const c = caseFile('mc_slope_k1e-3_single_point.json');
+  c.time.end = 0.1;
+  c.output.frame_interval = 0.02;
+  return c;
+}
+const FOOTING_RAMP = 0.02;      // s: the load's whole ramp lies inside the short run
+function shortFooting() {
+  const c = caseFile('strip_footing_fbar.json');
+  c.time.end = 0.02;
+  c.output.frame_interval = 0.005;
+  c.loads[0].time_function = { kind: 'ramp', ramp_time: FOOTING_RAMP };
+  return c;
+}
+
+async function waitEnded(token, id) {
+  for (const start = Date.now(); Date.now() - start < WAIT;) {
+    const j = (await api(token, 'GET', `/v1/jobs/${id}`)).body;
+    if (['succeeded', 'failed', 'cancelled'].includes(j.state)) return j.state;
+    await new Promise((r) => setTimeout(r, 250));
+  }
+  return 'timed out';
+}
+
+async function download(token, id, file, to) {
+  const res = await fetch(`${url}/v1/jobs/${id}/files/${file}`, { headers: { Authorization: `Bearer ${token}` } });
+  fs.writeFileSync(to, Buffer.from(await res.arrayBuffer()));
+  return to;
+}
+
+// a and b agree to within tol times the larger magnitude of b's values
+function sameSeries(a, b, tol) {
+  const scale = Math.max(...b.map(Math.abs)) || 1;
+  return a.length === b.length && a.every((v, i) => Math.abs(v - b[i]) <= tol * scale);
+}
+
 const browser = await chromium.launch({
   executablePath: '/usr/bin/chromium', headless: true,
   args: ['--no-sandbox', '--disable-gpu', '--disable-quic', '--no-first-run', '--disable-background-networking',
@@ -106,7 +147,12 @@ try {
   const example = JSON.parse(await page.inputValue('#case-editor'));
   example.grid.cell_size = -0.025;
   const badText = JSON.stringify(example, null, 2);
-  await page.fill('#case-editor', badText);
+  // the bad case arrives as an uploaded file
+  const badFile = path.join(env.WEB_TMP, 'bad-case.json');
+  fs.writeFileSync(badFile, badText);
+  await page.setInputFiles('#case-file', badFile);
+  await page.waitForFunction(() => document.querySelector('#case-editor').value.includes('-0.025'));
+  check('web_uploaded_case_in_editor', (await page.inputValue('#case-editor')) === badText, 'the editor does not hold the uploaded file');
   await page.click('#submit');
   await page.waitForSelector('#notes .field-error', { timeout: WAIT });
   const note = await page.$eval('#notes .field-error', (e) => ({ field: e.dataset.field, line: Number(e.dataset.line), text: e.textContent }));
@@ -177,6 +223,10 @@ try {
   await page.waitForFunction(() => ['succeeded', 'failed', 'cancelled'].includes(document.querySelector('#page').dataset.state), null, { timeout: WAIT });
   const seen = await page.evaluate(() => window.__seen);
   const state = await page.evaluate(() => document.querySelector('#page').dataset.state);
+  // the slope and the footing run on the same worker while the viewer and the Terzaghi plot are checked
+  const slope = await api(tokens.alice, 'POST', '/v1/jobs', { case: shortSlope(), name: 'slope-short' });
+  const foot = await api(tokens.alice, 'POST', '/v1/jobs', { case: shortFooting(), name: 'footing-short' });
+  check('web_slope_and_footing_submitted', slope.status === 201 && foot.status === 201, `answers ${slope.status}, ${foot.status}`);
   check('web_job_succeeded', state === 'succeeded', `ended ${state}: ${await page.textContent('#job-message')}`);
   check('web_states_queued_running_succeeded', seen.states.join(',') === 'queued,running,succeeded', `states seen: ${seen.states}`);
   check('web_no_reload', await page.evaluate(() => window.__sameDocument === true), 'the page was reloaded');
@@ -189,6 +239,11 @@ try {
   check('web_probes_plotted', (await page.$$('#probes .uplot')).length >= 2, 'fewer than 2 probe charts (Pa and m)');
   await page.waitForSelector('#job-files button[data-file="result.h5"]');
   await shot(page, '06-job-succeeded');
+  // a download from the page: fetched with the token, saved by the browser (compared below)
+  const [saved] = await Promise.all([page.waitForEvent('download', { timeout: WAIT }), page.click('#job-files button[data-file="result.h5"]')]);
+  const savedPath = path.join(env.WEB_TMP, 'downloaded.h5');
+  await saved.saveAs(savedPath);
+  check('web_download_named_as_the_file', saved.suggestedFilename() === 'result.h5', saved.suggestedFilename());
 
   // ---- b: the field viewer ----
   const index = (await api(tokens.alice, 'GET', `/v1/jobs/${jobId}/frames`)).body;
@@ -244,9 +299,9 @@ try {
   await page.goto(`${url}/#/jobs/${jobId}/plots`);
   await page.waitForFunction(() => window.poroPlots && window.poroPlots.terzaghi, null, { timeout: WAIT });
   const plotted = await page.evaluate(() => window.poroPlots.terzaghi.series[0]);
-  const h5 = path.join(env.WEB_TMP, 'result.h5');
-  const res = await fetch(`${url}/v1/jobs/${jobId}/files/result.h5`, { headers: { Authorization: `Bearer ${tokens.alice}` } });
-  fs.writeFileSync(h5, Buffer.from(await res.arrayBuffer()));
+  const h5 = await download(tokens.alice, jobId, 'result.h5', path.join(env.WEB_TMP, 'result.h5'));
+  check('web_download_is_the_stored_file', fs.readFileSync(savedPath).equals(fs.readFileSync(h5)) && fs.statSync(h5).size > 1000,
+    `page saved ${fs.statSync(savedPath).size} bytes, the API answers ${fs.statSync(h5).size}`);
   const run = JSON.parse(execFileSync('/usr/bin/python3', ['tests/web/frame_values.py', h5]).toString());
   const close = (a, b, scale) => Math.abs(a - b) <= 1e-6 * scale;   // the frames hold 32-bit floats
   const pScale = Math.max(...run.p.map(Math.abs)), yScale = Math.max(...run.y.map(Math.abs));
@@ -256,6 +311,38 @@ try {
     `plotted ${plotted.x.length} points, the run's last frame has ${run.y.length}; first plotted (${plotted.x[0]}, ${plotted.y[0]}), run (${run.y[0]}, ${run.p[0]})`);
   await page.waitForSelector('#plot-terzaghi .uplot');
   await shot(page, '09-plots-terzaghi');
+
+  // ---- 5: a slope's run-out and a footing's load-settlement plots are the runs' values ----
+  const slopeId = slope.body.id, footId = foot.body.id;
+  const slopeState = await waitEnded(tokens.alice, slopeId), footState = await waitEnded(tokens.alice, footId);
+  check('web_slope_and_footing_succeeded', slopeState === 'succeeded' && footState === 'succeeded', `slope ${slopeState}, footing ${footState}`);
+  await page.goto(`${url}/#/jobs/${slopeId}/plots`);
+  await page.waitForFunction(() => window.poroPlots && window.poroPlots.runout, null, { timeout: WAIT });
+  const runout = await page.evaluate(() => window.poroPlots.runout.series);
+  // poro-solve report reads the same result.h5 in a process of its own and prints its CSV
+  const csv = execFileSync(path.join(env.WEB_BUILD, 'poro-solve'),
+    ['report', await download(tokens.alice, slopeId, 'result.h5', path.join(env.WEB_TMP, 'slope.h5'))]).toString().trim().split('\n');
+  const cols = csv[0].split(','), rows = csv.slice(1).map((l) => l.split(',').map(Number));
+  const col = (name) => rows.map((r) => r[cols.indexOf(name)]);
+  const tol = 1e-8;             // frames.json keeps 9 significant digits (half a unit: 5e-9 of a value), the CSV 12
+  check('web_runout_plot_is_the_runs_report', rows.length >= 5 &&
+    sameSeries(runout[0].x, col('time'), tol) && sameSeries(runout[0].y, col('runout'), tol) &&
+    sameSeries(runout[1].x, col('time'), tol) && sameSeries(runout[1].y, col('crest_settlement'), tol),
+    `plotted ${JSON.stringify(runout.map((r) => r.y.slice(0, 3)))}, report ${JSON.stringify([col('runout').slice(0, 3), col('crest_settlement').slice(0, 3)])}`);
+  await page.waitForSelector('#plot-runout .uplot');
+  await shot(page, '09-plots-runout');
+  await page.goto(`${url}/#/jobs/${footId}/plots`);
+  await page.waitForFunction(() => window.poroPlots && window.poroPlots.footing, null, { timeout: WAIT });
+  const curve = (await page.evaluate(() => window.poroPlots.footing.series))[0];
+  const probe = JSON.parse(execFileSync('/usr/bin/python3', ['tests/web/frame_values.py',
+    await download(tokens.alice, footId, 'result.h5', path.join(env.WEB_TMP, 'footing.h5')), 'settlement_centre']).toString());
+  const q = Math.hypot(...shortFooting().loads[0].traction);
+  check('web_load_settlement_plot_is_the_runs_values', probe.time.length > 10 &&
+    sameSeries(curve.x, probe.value.map((v) => -v), 1e-12) &&
+    sameSeries(curve.y, probe.time.map((t) => q * Math.min(1, t / FOOTING_RAMP)), 1e-12),
+    `plotted ${curve.x.length} points, the probe has ${probe.time.length}; last plotted (${curve.x.at(-1)}, ${curve.y.at(-1)})`);
+  await page.waitForSelector('#plot-footing .uplot');
+  await shot(page, '09-plots-footing');
 
   await page.goto(`${url}/#/benchmarks`);
   await page.waitForSelector('#benchmarks-none', { timeout: WAIT });

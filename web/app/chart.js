@@ -18,17 +18,17 @@ function finiteSeries(s) {
   return [x, y];
 }
 
-// Tick labels that stay distinct at any scale (uPlot's own print -0 for -0.0004).
-function tick(v, step) {
-  if (v === 0) return '0';
-  const a = Math.abs(v);
-  if (a >= 1e5 || a < 1e-3 || step < 1e-3) return v.toExponential(Math.max(0, Math.min(3, Math.ceil(Math.log10(a / step)))));
-  const decimals = Math.max(0, Math.min(6, -Math.floor(Math.log10(step))));
-  return v.toLocaleString('en', { minimumFractionDigits: decimals, maximumFractionDigits: decimals });
-}
+// Tick labels with one number of decimals on an axis, as few as write every tick exactly, and
+// one power of ten for the whole axis past 1e5 or below 1e-3 (uPlot's own labels print -0 for
+// -0.0004, and labels formatted one by one mixed 3e-5 with 2.75e-4 on one axis).
 const ticks = (u, values) => {
-  const step = values.length > 1 ? Math.abs(values[1] - values[0]) : Math.abs(values[0]) || 1;
-  return values.map((v) => tick(v, step));
+  const big = Math.max(...values.map(Math.abs));
+  const e = big >= 1e5 || (big > 0 && big < 1e-3) ? Math.floor(Math.log10(big)) : 0;
+  const scaled = values.map((v) => v / 10 ** e);
+  let d = 0;
+  while (d < 6 && scaled.some((v) => Math.abs(Number(v.toFixed(d)) - v) > 1e-9 * Math.max(1, Math.abs(v)))) d++;
+  return scaled.map((v) => (Math.abs(v) < 0.5 * 10 ** -d ? '0' : e ? `${v.toFixed(d)}e${e}`
+    : v.toLocaleString('en', { minimumFractionDigits: d, maximumFractionDigits: d })));
 };
 
 // spec: {name, title, xLabel, yLabel, series: [{label, x, y, points, colour, dash}], width, height}

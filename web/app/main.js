@@ -7,7 +7,7 @@
 //   #/jobs/ID/plots         plots of a job                       (plots.js)
 //   #/submit                paste or upload a case               (submit.js)
 //   #/admin                 workers and queues (admins)          (admin.js)
-//   #/benchmarks            the nightlies' history               (plots.js)
+//   #/benchmarks            the nightlies' history               (benchmarks.js)
 import { get, token } from './api.js';
 import { h, clear } from './dom.js';
 import * as signin from './signin.js';
@@ -17,6 +17,7 @@ import * as viewer from './viewer.js';
 import * as plots from './plots.js';
 import * as submit from './submit.js';
 import * as admin from './admin.js';
+import * as benchmarks from './benchmarks.js';
 
 const ROUTES = [
   [/^\/jobs\/(\d+)\/frames$/, viewer, (m) => ({ id: Number(m[1]) })],
@@ -25,7 +26,7 @@ const ROUTES = [
   [/^\/jobs$/, jobs, () => ({})],
   [/^\/submit$/, submit, () => ({})],
   [/^\/admin$/, admin, () => ({})],
-  [/^\/benchmarks$/, { render: plots.renderBenchmarks }, () => ({})],
+  [/^\/benchmarks$/, benchmarks, () => ({})],
 ];
 
 export const session = { admin: false, user: null };

@@ -5,9 +5,7 @@
 //   - a slope or landslide (polygon bodies): the run-out over time, from the report the worker
 //     extracted with the frames (frames.json "report", docs/report.md);
 //   - a footing (a load on part of a face): the load-settlement curve, the load from the case's
-//     time function and the settlement from a displacement probe;
-// and, on a page of its own (#/benchmarks), the benchmark history of the nightlies, from
-// GET /v1/benchmarks where the server has it.
+//     time function and the settlement from a displacement probe.
 import { get } from './api.js';
 import { h, clear } from './dom.js';
 import { chart } from './chart.js';
@@ -91,25 +89,6 @@ function footing(section, c, probes, charts) {
   return true;
 }
 
-// The nightlies' figures over time, when the server keeps them (GET /v1/benchmarks: an array of
-// {name, unit, points: [{at, value}]}); a server without that route says so.
-async function benchmarks(section, charts) {
-  section.append(h('h2', {}, 'Benchmark history of the nightlies'));
-  let list;
-  try {
-    list = await get('/v1/benchmarks');
-  } catch (e) {
-    section.append(h('p', { class: 'muted', id: 'benchmarks-none' }, 'This server keeps no benchmark history yet.'));
-    return;
-  }
-  for (const b of Array.isArray(list) ? list : list.benchmarks || []) {
-    const el = h('div', { class: 'plot' });
-    section.append(el);
-    charts.other.push(chart(el, { name: `bench-${b.name}`, title: b.name, xLabel: 'date', yLabel: b.unit || '',
-      series: [{ label: b.name, x: b.points.map((p) => new Date(p.at).getTime() / 1000), y: b.points.map((p) => p.value) }] }));
-  }
-}
-
 export async function render(root, { id }) {
   root.append(h('h1', {}, h('a', { href: `#/jobs/${id}` }, `Job ${id}`), ' · plots'));
   const charts = { other: [] };
@@ -128,13 +107,4 @@ export async function render(root, { id }) {
   }
   if (!any) section.append(h('p', { class: 'muted', id: 'plots-none' }, index ? 'This job is no consolidation column, slope or footing: see its probes on the job page and its fields in the viewer.' : 'No frames yet.'));
   return () => { for (const list of Object.values(charts)) for (const ch of list || []) ch && ch.destroy(); };
-}
-
-// The benchmarks page (#/benchmarks): the nightlies' history.
-export function renderBenchmarks(root) {
-  const charts = { other: [] };
-  const section = h('section', { class: 'card', id: 'benchmarks' });
-  root.append(h('h1', {}, 'Benchmarks'), section);
-  benchmarks(section, charts);
-  return () => { for (const ch of charts.other) ch && ch.destroy(); };
 }
