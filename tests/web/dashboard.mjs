@@ -176,7 +176,7 @@ try {
   const jobId = Number(page.url().match(/#\/jobs\/(\d+)$/)[1]);
   // record every state, bar width and log length the page shows, from inside the page
   await page.evaluate(() => {
-    window.__seen = { states: [], fractions: [], logWhileRunning: 0 };
+    window.__seen = { states: [], fractions: [], logWhileRunning: 0, probesWhileRunning: false };
     const tick = () => {
       const root = document.querySelector('#page');
       const s = root.dataset.state;
@@ -188,6 +188,7 @@ try {
         if (fr[fr.length - 1] !== f) fr.push(f);
         const lines = (document.querySelector('#log').textContent.match(/^step \d+/gm) || []).length;
         window.__seen.logWhileRunning = Math.max(window.__seen.logWhileRunning, lines);
+        if (document.querySelector('#probes .uplot')) window.__seen.probesWhileRunning = true;
       }
     };
     new MutationObserver(tick).observe(document.querySelector('#page'), { subtree: true, childList: true, attributes: true, characterData: true });
@@ -234,6 +235,8 @@ try {
   const inRun = seen.fractions.filter((f) => f > 0 && f < 1);
   check('web_progress_bar_advances', inRun.length >= 2 && inRun.every((f, i) => i === 0 || f > inRun[i - 1]),
     `fractions shown while running: ${seen.fractions}`);
+  // the worker uploads result.h5 and its probes at each checkpoint (every 0.2 s of the 1 s run)
+  check('web_probes_plotted_while_running', seen.probesWhileRunning, 'no probe chart on the page while the job ran');
   await page.waitForFunction(() => Number(document.querySelector('#progress-bar').dataset.fraction) === 1);
   await page.waitForSelector('#probes .uplot', { timeout: WAIT });
   check('web_probes_plotted', (await page.$$('#probes .uplot')).length >= 2, 'fewer than 2 probe charts (Pa and m)');
@@ -280,6 +283,23 @@ try {
   const unit = await page.textContent('#colour-title');
   check('web_viewer_colour_bar_has_unit', unit.includes('Pa'), unit);
   await shot(page, '07-viewer-last-frame');
+  // double point: the soil and the water points apart (pore pressure is the water points' field)
+  const counts = index.frames[last].counts;
+  const drawnOf = () => page.$eval('#field-canvas', (c) => [Number(c.dataset.drawn), Number(c.dataset.coloured)]);
+  const both = await drawnOf();
+  await page.selectOption('#points', 'water');
+  await page.waitForFunction((n) => Number(document.querySelector('#field-canvas').dataset.drawn) === n, counts.water, { timeout: 10000 }).catch(() => {});
+  const water = await drawnOf();
+  await page.selectOption('#points', 'soil');
+  await page.selectOption('#field', 'mean_effective_stress');
+  await page.waitForFunction(() => document.querySelector('#field-canvas').dataset.field === 'mean_effective_stress');
+  const soil = await drawnOf();
+  check('web_viewer_soil_and_water_apart', both[0] === counts.soil + counts.water && both[1] === counts.water &&
+    water[0] === counts.water && water[1] === counts.water && soil[0] === counts.soil && soil[1] === counts.soil,
+    `counts ${JSON.stringify(counts)}; drawn, coloured: both ${both}, water ${water}, soil ${soil}`);
+  await page.selectOption('#points', 'both');
+  await page.selectOption('#field', 'pore_pressure');
+  await page.waitForFunction(() => document.querySelector('#field-canvas').dataset.field === 'pore_pressure');
   const image = () => page.evaluate(() => { const c = document.querySelector('#field-canvas'); return c.toDataURL(); });
   const lastImage = await image();
   await page.$eval('#frame-slider', (s) => { s.value = '0'; s.dispatchEvent(new Event('input')); });
@@ -293,6 +313,13 @@ try {
   const before_zoom = await image();
   await page.click('#zoom-in');
   check('web_viewer_zooms', (await image()) !== before_zoom, 'the canvas did not change on zoom');
+  const box = await page.$eval('#field-canvas', (c) => { const r = c.getBoundingClientRect(); return { x: r.x + r.width / 2, y: r.y + r.height / 2 }; });
+  const before_pan = await image();
+  await page.mouse.move(box.x, box.y);
+  await page.mouse.down();
+  await page.mouse.move(box.x + 120, box.y + 40, { steps: 5 });
+  await page.mouse.up();
+  check('web_viewer_pans', (await image()) !== before_pan, 'the canvas did not change on a drag');
   await shot(page, '07-viewer-displacement-zoomed');
 
   // ---- b: the verification plot's points are the run's values ----
