@@ -59,6 +59,9 @@ json.dump({"case": c, "name": "web-api-run"}, open(sys.argv[2] + "/good.json", "
 c["grid"]["cell_size"] = -1
 c["bodies"][0]["porosity"] = 2
 json.dump({"case": c}, open(sys.argv[2] + "/bad.json", "w"))
+slope = json.load(open("tests/cases/mc_slope_k1e-3_single_point.json"))
+slope["materials"][0]["friction_angle"] = 0.52   # valid, but most likely meant as radians
+json.dump({"case": slope}, open(sys.argv[2] + "/warned.json", "w"))
 PY
 code=$(svc_req POST /v1/cases/validate "$alice" --data-binary @"$tmp/bad.json")
 fields=$(json '["error"]["problems"]' < "$SVC_BODY" | python3 -c 'import json, sys; print(" ".join(p["field"] for p in json.load(sys.stdin)))')
@@ -68,6 +71,11 @@ check validate_lists_problems_at_their_fields $? "status $code, fields '$fields'
 code=$(svc_req POST /v1/cases/validate "$alice" --data-binary @"$tmp/good.json")
 [ "$code" = 200 ] && [ "$(json '["valid"]' < "$SVC_BODY")" = true ] && json '["title"]' < "$SVC_BODY" | grep -q Terzaghi
 check validate_accepts_valid_case $? "status $code: $(head -c 300 "$SVC_BODY")"
+[ "$code" = 200 ] && [ "$(json '["warnings"]' < "$SVC_BODY")" = "[]" ]
+check validate_answers_no_warning_for_a_plain_case $? "status $code: $(head -c 300 "$SVC_BODY")"
+code=$(svc_req POST /v1/cases/validate "$alice" --data-binary @"$tmp/warned.json")
+[ "$code" = 200 ] && json '["warnings"]' < "$SVC_BODY" | grep -q '"field": "/case/materials/0/friction_angle"'
+check validate_answers_warnings_at_their_fields $? "status $code: $(head -c 300 "$SVC_BODY")"
 code=$(svc_req GET "/v1/jobs" "$alice")
 [ "$code" = 200 ] && [ "$(json '["jobs"]' < "$SVC_BODY")" = "[]" ]
 check validate_stores_no_job $? "status $code: $(head -c 300 "$SVC_BODY")"

@@ -166,6 +166,24 @@ try {
   check('web_bad_case_creates_no_job', after === before, `${before} jobs before, ${after} after`);
   check('web_bad_case_stays_on_submit_page', page.url().endsWith('#/submit'), page.url());
 
+  // ---- a valid case's warning is shown at its field, and the first Submit only shows it ----
+  await page.selectOption('#example', 'mc_slope_k1e-3_single_point.json');
+  await page.waitForFunction(() => document.querySelector('#case-editor').value.includes('friction_angle'));
+  const warnedCase = JSON.parse(await page.inputValue('#case-editor'));
+  warnedCase.materials[0].friction_angle = 0.52;   // valid, but most likely meant as radians
+  const warnedText = JSON.stringify(warnedCase, null, 2);
+  await page.fill('#case-editor', warnedText);
+  await page.click('#submit');
+  await page.waitForSelector('#notes .field-warning', { timeout: WAIT });
+  const warning = await page.$eval('#notes .field-warning', (e) => ({ field: e.dataset.field, line: Number(e.dataset.line) }));
+  const angleLine = warnedText.split('\n').findIndex((l) => l.includes('"friction_angle"')) + 1;
+  check('web_warning_at_its_field', warning.field === '/case/materials/0/friction_angle' && warning.line === angleLine,
+    `warning ${JSON.stringify(warning)}, friction_angle is on line ${angleLine}`);
+  const afterWarning = (await api(tokens.alice, 'GET', '/v1/jobs?limit=1000')).body.jobs.length;
+  check('web_first_submit_shows_warning_only', afterWarning === before && (await page.textContent('#submit-status')).includes('Submit again'),
+    `${before} jobs before, ${afterWarning} after; status '${await page.textContent('#submit-status')}'`);
+  await shot(page, '03-submit-warning');
+
   // ---- a: submit the Terzaghi case; queued -> running -> succeeded without a reload ----
   example.grid.cell_size = 0.025;
   await page.fill('#case-editor', JSON.stringify(shortTerzaghi(example), null, 2));

@@ -2,7 +2,10 @@
 // checked before it is sent (its JSON syntax here, then everything a submission checks by the
 // server's POST /v1/cases/validate: the case schema and the solver's own loader), and every
 // problem is shown at the field it names: the JSON pointer is found in the text (pointer.js),
-// its line marked and the message set beside it. Only a case that passes is submitted.
+// its line marked and the message set beside it. Only a case that passes is submitted. The
+// case's warnings (values that are valid but most likely not what was meant) are shown the same
+// way, in another colour; a case with warnings is submitted once they have been shown for its
+// text, at the second press of Submit.
 import { get, post, ApiError } from './api.js';
 import { h, clear } from './dom.js';
 import { locate } from './pointer.js';
@@ -36,11 +39,11 @@ export function render(root) {
     clear(gutter);
     const bad = new Map(marks.map((m) => [m.line, m]));
     for (let n = 1; n <= lines; n++)
-      gutter.append(h('div', { class: bad.has(n) ? 'err' : '', title: bad.has(n) ? bad.get(n).message : '' }, String(n)));
+      gutter.append(h('div', { class: bad.has(n) ? (bad.get(n).warning ? 'warn' : 'err') : '', title: bad.has(n) ? bad.get(n).message : '' }, String(n)));
     gutter.scrollTop = editor.scrollTop;
     clear(notes);
     for (const m of marks)
-      notes.append(h('div', { class: 'field-error', dataset: { field: m.field, line: m.line },
+      notes.append(h('div', { class: m.warning ? 'field-warning' : 'field-error', dataset: { field: m.field, line: m.line },
         style: `top:${PAD_PX + (m.line - 1) * LINE_PX - editor.scrollTop}px` }, `${m.pointer}: ${m.message}`));
   }
   editor.addEventListener('scroll', () => { gutter.scrollTop = editor.scrollTop; layout(); });
@@ -59,21 +62,23 @@ export function render(root) {
   }).catch(() => {});
   examples.onchange = async () => {
     if (!examples.value) return;
+    file.value = '';   // the editor no longer holds the uploaded file
     const res = await fetch('/web/examples/' + examples.value);
     setText(JSON.stringify(await res.json(), null, 2));
   };
-  file.onchange = async () => { if (file.files[0]) setText(await file.files[0].text()); };
+  file.onchange = async () => { if (file.files[0]) { examples.value = ''; setText(await file.files[0].text()); } };
 
   // Shows the problems: each at its line in the editor (fields of the case), and in the list.
-  function showProblems(list) {
+  function showProblems(list, warning = false) {
     marks = [];
     clear(problems);
+    problems.className = warning ? 'problems warnings' : 'problems';
     for (const p of list) {
       const inCase = p.field === '/case' || p.field.startsWith('/case/');
       const pointer = inCase ? p.field.slice(5) || '/' : p.field;
       const where = inCase ? locate(editor.value, pointer) : null;
-      if (where) marks.push({ field: p.field, pointer, line: where.line, message: p.message, start: where.start, end: where.end });
-      problems.append(h('li', { class: 'problem', dataset: { field: p.field } },
+      if (where) marks.push({ field: p.field, pointer, line: where.line, message: p.message, start: where.start, end: where.end, warning });
+      problems.append(h('li', { class: warning ? 'warning' : 'problem', dataset: { field: p.field } },
         where ? h('button', { class: 'link', onclick: () => { editor.focus(); editor.setSelectionRange(where.start, where.end); } }, `line ${where.line}`) : 'request',
         ' ', h('code', {}, pointer), ' ', p.message));
     }
@@ -101,16 +106,31 @@ export function render(root) {
     return b;
   }
 
-  async function check() {
+  // The body to submit, or null after showing why not: problems, or warnings not yet shown for
+  // this text when submitting.
+  let warned = null;   // the text whose warnings were last shown
+  async function check(submitting) {
     const b = body();
     if (!b) return null;
     status.textContent = 'Checking…';
     try {
       const ok = await post('/v1/cases/validate', b);
+      const warnings = ok.warnings || [];
       marks = [];
       clear(problems);
       layout();
       status.textContent = `The case is valid: ${ok.title || '(no title)'}.`;
+      if (warnings.length) {
+        showProblems(warnings, true);
+        const n = warnings.length === 1 ? '1 warning' : `${warnings.length} warnings`;
+        if (submitting && warned !== editor.value) {
+          warned = editor.value;
+          status.textContent = `The case is valid, with ${n}: press Submit again to submit it as it is.`;
+          return null;
+        }
+        warned = editor.value;
+        status.textContent = `The case is valid, with ${n}: ${ok.title || '(no title)'}.`;
+      }
       return b;
     } catch (e) {
       if (!(e instanceof ApiError)) throw e;
@@ -121,12 +141,12 @@ export function render(root) {
     }
   }
 
-  validateBtn.onclick = () => { status.className = 'muted'; check(); };
+  validateBtn.onclick = () => { status.className = 'muted'; check(false); };
   submitBtn.onclick = async () => {
     status.className = 'muted';
     submitBtn.disabled = true;
     try {
-      const b = await check();
+      const b = await check(true);
       if (!b) return;
       const job = await post('/v1/jobs', b);
       location.hash = `#/jobs/${job.id}`;
