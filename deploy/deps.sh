@@ -22,6 +22,11 @@ packages=(
   python3-paraview      # ParaView's own XDMF readers, which tests/cli/paraview_test.sh opens
                         # result.xdmf with (no display needed: readers only)
   curl procps           # the service tests speak HTTP with curl and find processes with pgrep
+  python3-jsonschema    # the metrics and suite documents checked against schemas/ (tests)
+  python3-junitparser   # a JUnit XML reader: the nightly's JUnit report read by a real consumer
+  python3-pil           # the nightly test looks for the plots in chromium's screenshot
+  chromium              # headless: the nightly's HTML report opened and drawn (tests)
+  util-linux            # taskset: the nightly test's second machine fingerprint (one processor)
   systemd               # systemd-analyze: tests/install/install_test.sh verifies the installed units
                         # (no systemd needs to run for that)
   man-db                # man -l: the same test renders the installed man pages
@@ -29,9 +34,16 @@ packages=(
                         # driven by playwright-core; no browser is ever downloaded
 )
 
+# `deps.sh fuzz` (make fuzz) adds what the fuzzers build with: clang with libFuzzer and its
+# sanitizer runtimes, clang's OpenMP runtime, and dpkg-source to unpack jansson's Debian source
+# (fuzz/jansson.sh). make test needs none of them.
+if [ "${1:-}" = fuzz ]; then
+  packages=(clang libclang-rt-14-dev libomp-dev dpkg-dev)
+fi
+
 # The OpenAPI linter of make test (tools/openapi-lint, pinned in its package-lock.json) runs on
 # Node.js >= 20.19; Debian's nodejs package is installed only where no node is present at all.
-command -v node >/dev/null 2>&1 || packages+=(nodejs npm)
+[ "${1:-}" = fuzz ] || command -v node >/dev/null 2>&1 || packages+=(nodejs npm)
 
 missing=()
 for p in "${packages[@]}"; do

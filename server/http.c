@@ -25,6 +25,7 @@
  * transactions, so a failed one leaves nothing half done.
  */
 #include "api.h"
+#include "bench.h"
 #include "front_door.h"
 #include "http.h"
 #include "log.h"
@@ -95,6 +96,12 @@ static const struct route ROUTES[] = {
 	{ "GET", "/v1/jobs/{id}/frames", USER_ROLES, BODY_SMALL, frames_index, 0, 0, 0, 0 },
 	{ "GET", "/v1/jobs/{id}/frames/{frame}", USER_ROLES, BODY_SMALL, frames_get, 0, 0, 0, 0 },
 	{ "GET", "/v1/admin/workers", ROLE_ADMIN, BODY_SMALL, web_admin_workers, 0, 0, 0, 0 },
+	/* benchmark runs (bench.h): a plan names up to 500 cases, so it may be larger than a small body */
+	{ "POST", "/v1/benchmarks", USER_ROLES, BODY_CASE, bench_create, 0, 0, 0, 0 },
+	{ "GET", "/v1/benchmarks", USER_ROLES, BODY_SMALL, bench_list, 0, 0, 0, 0 },
+	{ "GET", "/v1/benchmarks/series", USER_ROLES, BODY_SMALL, bench_series, 0, 0, 0, 0 },
+	{ "GET", "/v1/benchmarks/{id}", USER_ROLES, BODY_SMALL, bench_show, 0, 0, 0, 0 },
+	{ "POST", "/v1/benchmarks/{id}/finish", USER_ROLES, BODY_SMALL, bench_finish, 0, 0, 0, 0 },
 };
 #define ROUTE_COUNT (sizeof ROUTES / sizeof ROUTES[0])
 
@@ -251,6 +258,14 @@ void reply_header(struct request *r, const char *name, const char *value)
 	rep->header_count++;
 }
 
+static int reply_has_header(struct request *r, const char *name)
+{
+	for (int i = 0; i < r->reply.header_count; i++)
+		if (strcasecmp(r->reply.headers[i][0], name) == 0)
+			return 1;
+	return 0;
+}
+
 void reply_text(struct request *r, int status, const char *content_type, char *owned_text, size_t size)
 {
 	free(r->reply.body);
@@ -286,7 +301,11 @@ void reply_error(struct request *r, struct api_error *err)
 	if (err->code == API_LOG_GAP)
 		json_object_set_new(e, "expected_offset", json_integer(err->expected_offset));
 	reply_header(r, "Cache-Control", "no-store");
-	reply_json(r, api_code_status(err->code), json_pack("{s:o}", "error", e));
+	/* the server's passing states (no memory, a failing or full disk) say when to try again */
+	int status = api_code_status(err->code);
+	if ((status == 503 || status == 507) && !reply_has_header(r, "Retry-After"))
+		reply_header(r, "Retry-After", status == 507 ? "10" : "1");
+	reply_json(r, status, json_pack("{s:o}", "error", e));
 }
 
 enum api_code reply_fail(struct request *r, enum api_code code, const char *field, const char *fmt, ...)

@@ -21,6 +21,7 @@
 
 #include "case.h"
 #include "digest.h"
+#include "jobs_submit.h"
 
 #include <stdio.h>
 #include <stdlib.h>
@@ -80,7 +81,7 @@ static int check_case(struct request *r, const json_t *case_spec, struct case_sp
 		reply_fail(r, API_UNAVAILABLE, "", "no memory to check the case: retry later");
 		return -1;
 	}
-	enum poro_status st = case_load_json(case_spec, loaded, perr);
+	enum poro_status st = jobs_case_load(case_spec, loaded, perr);   /* by the loader its schema names */
 	if (st == PORO_OK) {
 		free(perr);
 		return 0;
@@ -146,6 +147,8 @@ struct submission {
 	char *title;                     /* the case's title, owned, or NULL */
 	json_t *warnings;                /* the case's warnings as [{field, message}], owned */
 	const char *key;                 /* the Idempotency-Key header, or NULL */
+	char *batch;                     /* owned, or NULL (jobs_batch.c) */
+	int exclusive;
 	long long priority, threads, wall;
 	char case_sha[DIGEST_HEX_SIZE], body_sha[DIGEST_HEX_SIZE];
 };
@@ -155,6 +158,7 @@ static void submission_release(struct submission *s)
 	free(s->canonical);
 	free(s->name);
 	free(s->title);
+	free(s->batch);
 	json_decref(s->warnings);
 }
 
@@ -163,7 +167,8 @@ static void submission_release(struct submission *s)
  * replying. */
 static int submission_check(struct request *r, struct submission *s)
 {
-	static const char *const keys[] = { "case", "priority", "threads", "wall_time_seconds", "name", NULL };
+	static const char *const keys[] = { "case", "priority", "threads", "wall_time_seconds", "name", "batch",
+					    "exclusive", NULL };
 	json_t *body = api_body_object(r);
 	if (!body)
 		return -1;
@@ -181,7 +186,8 @@ static int submission_check(struct request *r, struct submission *s)
 	if (api_int_member(r, body, "priority", PRIORITY_MIN, PRIORITY_MAX, 0, &s->priority) ||
 	    api_int_member(r, body, "threads", 1, THREADS_MAX, 1, &s->threads) || check_threads(r, s->threads) ||
 	    api_int_member(r, body, "wall_time_seconds", 1, WALL_TIME_MAX, WALL_TIME_DEFAULT, &s->wall) ||
-	    api_string_member(r, body, "name", SERVER_NAME_MAX, 0, &name) || check_case(r, case_spec, &loaded))
+	    api_string_member(r, body, "name", SERVER_NAME_MAX, 0, &name) ||
+	    jobs_batch_members(r, body, &s->batch, &s->exclusive) || check_case(r, case_spec, &loaded))
 		goto done;
 	whole = json_dumps(body, JSON_COMPACT | JSON_SORT_KEYS);
 	s->name = name ? strdup(name) : NULL;
@@ -223,7 +229,7 @@ void jobs_submit(struct request *r)
 	struct job_submit in = { .who = &r->who, .idempotency_key = s.key, .body_sha256 = s.body_sha,
 				 .case_json = s.canonical, .case_sha256 = s.case_sha, .name = s.name, .case_title = s.title,
 				 .priority = (int)s.priority, .threads = (int)s.threads,
-				 .wall_time_seconds = (int)s.wall };
+				 .wall_time_seconds = (int)s.wall, .batch = s.batch, .exclusive = s.exclusive };
 	json_t *job = NULL;
 	int created = 0;
 	struct api_error err = { 0 };

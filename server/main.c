@@ -268,7 +268,7 @@ static int open_state(struct server *srv, int *lock_fd)
 {
 	const char *state = srv->cfg.state;
 	char msg[SERVER_MESSAGE_MAX], files[SERVER_PATH_MAX];
-	if (fs_make_dirs(state) != 0) {
+	if (fs_make_dirs(state) != 0 || fs_sync_parents(state, 1) != 0) {
 		log_say(LOG_PRIO_ERR, "cannot create state directory '%s': %s", state, strerror(errno));
 		return -1;
 	}
@@ -279,7 +279,7 @@ static int open_state(struct server *srv, int *lock_fd)
 	state_dir_restrict(state);
 	/* /healthz creates its probe file here, so files/ exists before the first upload */
 	snprintf(files, sizeof files, "%s/files", state);
-	if (fs_make_dirs(files) != 0)
+	if (fs_make_dirs(files) != 0 || fs_sync_parents(files, 1) != 0)
 		log_say(LOG_PRIO_WARNING, "cannot create '%s': %s", files, strerror(errno));
 	if (state_dir_open_store(&srv->cfg, srv, &srv->store, msg, sizeof msg) != 0) {
 		log_say(LOG_PRIO_ERR, "%s", msg);

@@ -74,6 +74,7 @@ struct server_config {
 	X(API_LOG_GAP,              409, "log_gap")                          \
 	X(API_ALREADY_EXISTS,       409, "already_exists")                   \
 	X(API_ARTIFACT_MISSING,     409, "artifact_missing")                 \
+	X(API_NOT_FINISHED,         409, "not_finished")                     \
 	X(API_TOO_LARGE,            413, "body_too_large")                   \
 	X(API_BODY_TOO_COMPLEX,     413, "body_too_complex")                 \
 	X(API_URI_TOO_LONG,         414, "uri_too_long")                     \
@@ -89,6 +90,7 @@ struct server_config {
 	X(API_STORED_FILE_DAMAGED,  500, "stored_file_damaged")              \
 	X(API_NOT_IMPLEMENTED,      501, "not_implemented")                  \
 	X(API_UNAVAILABLE,          503, "unavailable")                      \
+	X(API_INSUFFICIENT_STORAGE, 507, "insufficient_storage")             \
 	X(API_VERSION_NOT_SUPPORTED, 505, "http_version_not_supported")
 
 enum api_code {
@@ -109,6 +111,10 @@ struct api_error {
 enum api_code api_fail(struct api_error *err, enum api_code code, const char *field, const char *fmt, ...)
 	__attribute__((format(printf, 4, 5)));
 void api_error_release(struct api_error *err);
+/* The answer to a failed write, fsync or create on the state file system, by its errno: 507
+ * insufficient_storage for a full disk or quota or a file-size limit (ENOSPC, EDQUOT, EFBIG),
+ * else 503 unavailable (an I/O error). Both are the server's passing state: retry later. */
+enum api_code api_storage_code(int e);
 int api_code_status(enum api_code code);
 const char *api_code_name(enum api_code code);
 

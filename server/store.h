@@ -76,6 +76,8 @@ struct job_submit {
 	const char *name;             /* or NULL */
 	const char *case_title;       /* the case's "title", or NULL */
 	int priority, threads, wall_time_seconds;
+	const char *batch;            /* the benchmark run's label, or NULL (jobs_submit.h) */
+	int exclusive;                /* 1: runs alone on its worker */
 };
 /* Stores a queued job and its "submitted" event. *created is 1 for a new job, 0 when the
  * idempotency key returned an existing one. API_IDEMPOTENCY_CONFLICT; API_QUOTA_EXCEEDED when the
@@ -161,9 +163,11 @@ enum api_code store_job_counts(struct store *s, long long counts[JOB_STATE_COUNT
 struct job_claim {
 	const struct principal *who;
 	const char *worker, *host;
+	int exclusive_ok;             /* the worker runs nothing now: it may take an exclusive job */
 	long long claim_latency_ms;   /* out: submit (or requeue) to claim */
 };
-/* Leases the next job by fair share (docs/service.md §2); *job is NULL when none is claimable. */
+/* Leases the next job by fair share (docs/service.md §2), leaving exclusive jobs to claims with
+ * exclusive_ok; *job is NULL when none is claimable. */
 enum api_code store_claim(struct store *s, struct job_claim *in, json_t **job, struct api_error *err);
 /* Renews the lease of (id, attempt); progress (object or NULL) and solver_version (or NULL) are
  * recorded. *cancel is 1 when a cancel was requested. */
@@ -237,6 +241,39 @@ enum api_code store_finish(struct store *s, const struct principal *who, long lo
  * overruns failed. Counts what it did. */
 struct reap_counts { int expired, retried, lost, cancelled, overrun; };
 enum api_code store_reap(struct store *s, struct reap_counts *counts, struct api_error *err);
+
+/* ---- benchmark runs (store_bench.c; bench.h says what they are) ----
+ * A run as JSON: {"id", "suite", "label", "commit", "user", "client_host", "state", "solver_version",
+ * "machine", "fingerprint", "summary", "created_at", "finished_at"} and, when full, "settings",
+ * "cases" (the plan's) and "figures" (one row each once finished: {"figure", "case", "kind",
+ * "class", "check", "unit", "case_sha256", "machine", "samples", "median", "band", "status",
+ * "detail", "stats"}). Every user may read every run: they are about the solver, not a user's
+ * work. */
+/* Stores a new running run; API_ALREADY_EXISTS when its label is taken. */
+enum api_code store_bench_create(struct store *s, const struct principal *who, const char *suite, const char *label,
+				 const char *commit, const char *host, const json_t *plan, json_t **run,
+				 struct api_error *err);
+/* A run (full: with its plan and figures); *owner (may be NULL) its user's id. API_NOT_FOUND. */
+enum api_code store_bench_get(struct store *s, long long id, int full, json_t **run, long long *owner,
+			      struct api_error *err);
+/* Runs newest first, of one suite or (suite NULL) all: {"runs": [...], "next_after": ID or null}. */
+enum api_code store_bench_list(struct store *s, const char *suite, int limit, long long after, json_t **page,
+			       struct api_error *err);
+/* The latest limit rows of a figure in a suite, on one machine fingerprint (NULL: every machine),
+ * oldest first: [{"run", "label", "commit", "created_at", "solver_version", "machine", "samples",
+ * "median", "status", "band"}]. */
+enum api_code store_bench_series(struct store *s, const char *suite, const char *figure, const char *fingerprint,
+				 int limit, json_t **points, struct api_error *err);
+/* A timing figure's history: the samples of figure in suite on fingerprint for the same case text,
+ * from the latest `runs` runs before run before_id that measured it (*samples malloc'd, *count
+ * values from *run_count runs). */
+enum api_code store_bench_history(struct store *s, const char *suite, const char *figure, const char *fingerprint,
+				  const char *case_sha256, long long before_id, int runs, double **samples, int *count,
+				  int *run_count, struct api_error *err);
+/* Ends a running run with result {"state", "solver_version", "machine", "fingerprint", "summary",
+ * "figures": [rows as above]}; a run that is no longer running is left as it is (*changed 0). */
+enum api_code store_bench_finish(struct store *s, long long id, const json_t *result, int *changed,
+				 struct api_error *err);
 
 /* Seconds of writer transactions, for the poro_commit_seconds histogram (set by the writer). */
 void store_set_commit_observer(struct store *s, void (*observe)(void *cls, double seconds), void *cls);

@@ -4,7 +4,7 @@
  * first; a job's case text; the running jobs and the queue per user for the admin view.
  *
  * The search is one index range scan in id order, LIMITed to limit + 1 rows, like every listing.
- * The index is a covering one of migration 4, named with INDEXED BY so the plan cannot drift with
+ * The index is a covering one of migration 5, named with INDEXED BY so the plan cannot drift with
  * the table's statistics: jobs_user_search (user_id, id, state, created_at, name, case_title) when
  * the owner is known (a user, or an admin's user= filter), jobs_search (id, state, created_at,
  * user_id, name, case_title) for an admin's search over everyone. SQLite evaluates the filters on
@@ -182,7 +182,7 @@ static enum api_code overview_running(struct store *s, struct conn *c, json_t *r
 		return db_fail(c, err, "reading the running jobs");
 	while (sqlite3_step(st) == SQLITE_ROW) {
 		json_t *job = job_from_row(s, st);
-		json_object_set_new(job, "worker", col_json_text(st, 22));
+		json_object_set_new(job, "worker", col_json_text(st, 24));
 		json_array_append_new(running, job);
 	}
 	sqlite3_reset(st);

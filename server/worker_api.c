@@ -56,7 +56,7 @@ static void wait_for_work(struct server *srv, unsigned long long seq, long long 
 
 void worker_claim(struct request *r)
 {
-	static const char *const keys[] = { "worker", "host", "threads", "wait_seconds", NULL };
+	static const char *const keys[] = { "worker", "host", "threads", "wait_seconds", "exclusive", NULL };
 	json_t *body = api_body_object(r);
 	if (!body)
 		return;
@@ -69,8 +69,17 @@ void worker_claim(struct request *r)
 		json_decref(body);
 		return;
 	}
+	/* "exclusive": true says the worker runs nothing now and may take an exclusive job (a worker
+	 * that does not say so never gets one) */
+	json_t *exclusive = json_object_get(body, "exclusive");
+	if (exclusive && !json_is_boolean(exclusive) && !json_is_null(exclusive)) {
+		reply_fail(r, API_INVALID_REQUEST, "/exclusive", "'exclusive' must be true or false");
+		json_decref(body);
+		return;
+	}
 	struct server *srv = r->srv;
-	struct job_claim in = { .who = &r->who, .worker = worker, .host = host ? host : worker };
+	struct job_claim in = { .who = &r->who, .worker = worker, .host = host ? host : worker,
+				.exclusive_ok = json_is_true(exclusive) };
 	long long deadline = now_ms() + 1000 * wait;
 	metrics_worker_claim(srv->metrics, worker, r->who.name, in.host, (int)threads, 1);
 	server_worker_seen(srv);

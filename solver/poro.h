@@ -96,6 +96,9 @@ struct sim_progress {
 					    DIR/checkpoint.h5 now holds this step (checkpoint.h) */
 	int iterations_last;             /* a scheme that iterates (sim_iterations): the last step's */
 	double iterations_mean;          /* and the mean a step since the start; 0 for the others */
+	const double *energies;          /* the last step's |delta . r| per iteration (its first
+					    energy_count, at most SIM_ITERATIONS_KEPT); NULL for the others */
+	int energy_count;
 };
 typedef void (*sim_progress_fn)(const struct sim_progress *p, void *user);
 
@@ -111,5 +114,24 @@ enum poro_status sim_run(struct sim *s, const char *out_dir, const char *solver_
 
 /* Wall-clock interval between checkpoints in sim_run, s; 0 (the default) = by simulated time only. */
 void sim_set_checkpoint_wall(struct sim *s, double seconds);
+
+/* What the steps sim_run took in this process cost (a resumed run counts from its checkpoint):
+ * wall and processor seconds (CLOCK_PROCESS_CPUTIME_ID: every thread), the steps, and the points
+ * stepped (soil plus water points), for the timing figures (figures.h). Frames, probes and
+ * checkpoints between the steps are not counted. */
+struct sim_timing {
+	double wall_seconds, cpu_seconds;
+	double median_step_cpu;          /* s: the median step's processor time (step_timing.h) */
+	long steps;
+	long points;
+};
+void sim_get_timing(const struct sim *s, struct sim_timing *t);
+
+/* A test knob, never set by a case (docs/benchmarks.md, "Test knobs"): with factor > 1 sim_run
+ * repeats, before each step, the step's first phase (the shape functions at the points' present
+ * positions, which the step then computes again from the same positions) until that costs
+ * (factor - 1) times the previous step's processor time, so each step costs about factor times
+ * as much and every result stays bit-identical. 1 (the default) is off. */
+void sim_set_slowdown(struct sim *s, double factor);
 
 #endif

@@ -45,9 +45,9 @@
 /* Seconds the finish call still gets when the final uploads used up WORKER_FINISH_PATIENCE: an
  * attempt whose files could not be sent is reported, not left to expire. */
 #define JOB_REPORT_PATIENCE 60.0
-/* Files a finish declares: result.h5, probes.json, frames.bin, frames.json, result.xdmf,
- * checkpoint.h5. */
-#define JOB_ARTIFACTS_MAX 6
+/* Files a finish declares: result.h5, probes.json, frames.bin, frames.json, metrics.json,
+ * result.xdmf, checkpoint.h5. */
+#define JOB_ARTIFACTS_MAX 7
 #define JOB_PROBES_NAME "probes.json"
 #define JOB_FRAMES_BIN "frames.bin"      /* the frames in the dashboard's compact form (probes.h) */
 #define JOB_FRAMES_INDEX "frames.json"   /* their index, uploaded after frames.bin */
@@ -538,7 +538,8 @@ static void final_uploads(struct job *j, double deadline)
 {
 	/* declared[] has room for each of them */
 	static const char *const names[JOB_ARTIFACTS_MAX] = {"result.h5", JOB_PROBES_NAME, JOB_FRAMES_BIN,
-							     JOB_FRAMES_INDEX, "result.xdmf", "checkpoint.h5"};
+							     JOB_FRAMES_INDEX, "metrics.json", "result.xdmf",
+							     "checkpoint.h5"};
 	/* a checkpoint announced but not yet sent goes first, as during the run */
 	while ((j->up_result.pending || j->up_checkpoint.pending) && wait_retry(j, &j->up_b, deadline))
 		checkpoint_uploads(j, worker_now());
@@ -709,6 +710,27 @@ static int prepare(struct job *j, const json_t *claim, char *err, size_t err_siz
 	return 0;
 }
 
+/* An exclusive job starts its solver only when no other job of this worker runs, any other job
+ * only when no exclusive job runs or waits (slot_try_start, docs/benchmarks.md "Exclusive
+ * jobs"); meanwhile the lease is renewed. 0 when it may start, -1 with err when the worker stops
+ * or the lease is lost first. */
+static int wait_turn(struct job *j, int exclusive, char *err, size_t err_size)
+{
+	int said = 0;
+	while (!slot_try_start(exclusive)) {
+		if (atomic_load(&worker_stopping) || j->stop == STOP_LOST) {
+			snprintf(err, err_size, "the worker stopped before the job's turn to run came");
+			return -1;
+		}
+		if (!said++)
+			worker_say("%s: waits to start: %s", j->tag, exclusive ? "an exclusive job runs alone, and other "
+				   "jobs of this worker are running" : "an exclusive job runs, or waits to run alone");
+		heartbeat_if_due(j, worker_now());
+		usleep(50000);
+	}
+	return 0;
+}
+
 /* Downloads the checkpoint of an earlier attempt; 0, or -1 with err. */
 static int fetch_checkpoint(struct job *j, const json_t *checkpoint, char *err, size_t err_size)
 {
@@ -778,7 +800,7 @@ static int start_solver(struct job *j, int resume, char *err, size_t err_size)
 	return 0;
 }
 
-void job_run(struct http_client *c, const json_t *claim)
+int job_run(struct http_client *c, const json_t *claim)
 {
 	struct job j = {0};
 	char err[10000];
@@ -787,12 +809,16 @@ void job_run(struct http_client *c, const json_t *claim)
 	j.chunk = malloc(WORKER_LOG_CHUNK);
 	int prepared = prepare(&j, claim, err, sizeof err) == 0 && j.chunk;
 	const json_t *checkpoint = json_object_get(claim, "checkpoint");
-	int resume = json_is_object(checkpoint);
-	worker_say("%s: claimed (%d thread%s, wall time %ld s%s)", j.tag, j.threads, j.threads == 1 ? "" : "s",
-		   j.wall_time, resume ? ", from a checkpoint" : "");
-	int started = 0;
+	int resume = json_is_object(checkpoint), exclusive = json_is_true(json_object_get(claim, "exclusive"));
+	worker_say("%s: claimed (%d thread%s, wall time %ld s%s%s)", j.tag, j.threads, j.threads == 1 ? "" : "s",
+		   j.wall_time, resume ? ", from a checkpoint" : "", exclusive ? ", exclusive" : "");
+	int started = 0, turn = 0;
 	if (prepared && resume && fetch_checkpoint(&j, checkpoint, err, sizeof err) < 0)
 		prepared = 0;
+	if (prepared) {
+		turn = wait_turn(&j, exclusive, err, sizeof err) == 0;
+		prepared = turn;
+	}
 	if (prepared && start_solver(&j, resume, err, sizeof err) == 0)
 		started = 1;
 	double deadline;
@@ -827,4 +853,5 @@ void job_run(struct http_client *c, const json_t *claim)
 	 * file of the attempt is not on the server: then it is the only copy */
 	if (!worker_opt.keep_work && !j.keep)
 		job_files_remove_tree(j.dir);
+	return turn;
 }

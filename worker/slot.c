@@ -4,19 +4,102 @@
  * at once when the worker drains; the job client never aborts, so a draining worker still delivers
  * its running jobs' logs, files and outcomes. A claim that fails for want of a server is retried
  * with backoff; a refused token ends the worker.
+ *
+ * Exclusive jobs (docs/benchmarks.md "Exclusive jobs": the jobs that time the solver) run alone
+ * on the worker. The slots share three facts under one lock: how many jobs run, whether an
+ * exclusive job runs or waits for its turn, and whether a slot's claim is the one that may be
+ * answered with an exclusive job. A claim says "exclusive": true only when no job runs and no
+ * other slot's claim says so, so the server hands an exclusive job to an idle worker, one claim
+ * at a time. A claim already waiting may still bring back another job; so a job also waits for
+ * its turn before its solver starts (slot_try_start, job.c): an exclusive job until no other job
+ * runs, any other job while an exclusive one runs or waits. And no slot claims while an exclusive
+ * job runs or waits.
  */
+#include <pthread.h>
 #include <stdio.h>
 #include <string.h>
+#include <time.h>
 
 #include "backoff.h"
 #include "http_client.h"
 #include "job.h"
 #include "worker.h"
 
-static json_t *claim_body(void)
+static pthread_mutex_t turn_lock = PTHREAD_MUTEX_INITIALIZER;
+static pthread_cond_t turn_changed = PTHREAD_COND_INITIALIZER;
+static int jobs_running;        /* solvers started and not yet finished */
+static int exclusive_pending;   /* an exclusive job was claimed: it runs or waits for its turn */
+static int exclusive_claimer;   /* a slot's claim may bring back an exclusive job */
+
+int slot_try_start(int exclusive)
 {
-	return json_pack("{s:s, s:s, s:i, s:i}", "worker", worker_opt.name, "host", worker_opt.host, "threads",
-			 worker_opt.threads, "wait_seconds", WORKER_CLAIM_WAIT);
+	pthread_mutex_lock(&turn_lock);
+	/* the exclusive job waiting for its turn is itself counted in exclusive_pending */
+	int may = exclusive ? jobs_running == 0 : !exclusive_pending;
+	if (may)
+		jobs_running++;
+	pthread_mutex_unlock(&turn_lock);
+	return may;
+}
+
+void slot_finished(int exclusive)
+{
+	pthread_mutex_lock(&turn_lock);
+	jobs_running--;
+	if (exclusive)
+		exclusive_pending = 0;
+	pthread_cond_broadcast(&turn_changed);
+	pthread_mutex_unlock(&turn_lock);
+}
+
+/* An exclusive job that never started (the worker stopped first) holds the worker no more. */
+static void exclusive_abandoned(void)
+{
+	pthread_mutex_lock(&turn_lock);
+	exclusive_pending = 0;
+	pthread_cond_broadcast(&turn_changed);
+	pthread_mutex_unlock(&turn_lock);
+}
+
+/* Before a claim: waits while an exclusive job runs or waits (the worker drains meanwhile, if
+ * told to); then 1 when this claim may be answered with an exclusive job, and it holds that right
+ * until claim_end. */
+static int claim_begin(void)
+{
+	pthread_mutex_lock(&turn_lock);
+	while (exclusive_pending && !atomic_load(&worker_draining)) {
+		struct timespec ts;
+		clock_gettime(CLOCK_REALTIME, &ts);
+		ts.tv_nsec += 200000000L;   /* a drain is noticed within 0.2 s */
+		if (ts.tv_nsec >= 1000000000L) {
+			ts.tv_sec++;
+			ts.tv_nsec -= 1000000000L;
+		}
+		pthread_cond_timedwait(&turn_changed, &turn_lock, &ts);
+	}
+	int may = jobs_running == 0 && !exclusive_claimer && !exclusive_pending;
+	if (may)
+		exclusive_claimer = 1;
+	pthread_mutex_unlock(&turn_lock);
+	return may;
+}
+
+/* After a claim: gives the right back; a claimed exclusive job holds the worker from now on. */
+static void claim_end(int claimer, int got_exclusive)
+{
+	pthread_mutex_lock(&turn_lock);
+	if (claimer)
+		exclusive_claimer = 0;
+	if (got_exclusive)
+		exclusive_pending = 1;
+	pthread_cond_broadcast(&turn_changed);
+	pthread_mutex_unlock(&turn_lock);
+}
+
+static json_t *claim_body(int exclusive_ok)
+{
+	return json_pack("{s:s, s:s, s:i, s:i, s:b}", "worker", worker_opt.name, "host", worker_opt.host, "threads",
+			 worker_opt.threads, "wait_seconds", WORKER_CLAIM_WAIT, "exclusive", exclusive_ok);
 }
 
 void *slot_main(void *arg)
@@ -32,18 +115,30 @@ void *slot_main(void *arg)
 		http_client_set_abort(claimer, &worker_draining);
 	}
 	struct backoff b = {0};
-	json_t *body = claim_body();
 	while (!atomic_load(&worker_draining)) {
 		struct http_response r;
 		char why[700];
+		int may_exclusive = claim_begin();
+		if (atomic_load(&worker_draining)) {
+			claim_end(may_exclusive, 0);
+			break;
+		}
+		json_t *body = claim_body(may_exclusive);
 		long status = http_json(claimer, "POST", "/v1/worker/claim", body, NULL, WORKER_CLAIM_WAIT + 30, &r);
+		json_decref(body);
+		const json_t *job = status == 200 ? json_object_get(r.json, "job") : NULL;
+		int exclusive = json_is_object(job) && json_is_true(json_object_get(job, "exclusive"));
+		claim_end(may_exclusive, exclusive);
 		if (atomic_load(&worker_draining) && status == 0) {
 			http_response_release(&r);
 			break;
 		}
-		if (status == 200 && json_is_object(json_object_get(r.json, "job"))) {
+		if (json_is_object(job)) {
 			backoff_reset(&b);
-			job_run(runner, json_object_get(r.json, "job"));
+			if (job_run(runner, job))
+				slot_finished(exclusive);
+			else if (exclusive)
+				exclusive_abandoned();
 		} else if (status == 204) {
 			backoff_reset(&b);
 		} else if (status == 401 || status == 403) {
@@ -58,7 +153,6 @@ void *slot_main(void *arg)
 		}
 		http_response_release(&r);
 	}
-	json_decref(body);
 	http_client_destroy(&claimer);
 	http_client_destroy(&runner);
 	return NULL;

@@ -77,4 +77,10 @@ void worker_sleep(double seconds, int wake_on_drain);
 /* The claim loop of one slot; arg is the slot's index cast to a pointer. */
 void *slot_main(void *arg);
 
+/* Exclusive jobs (slot.c; docs/benchmarks.md "Exclusive jobs"): 1 when a claimed job may start
+ * its solver now, and then it counts as running: an exclusive job when no other job runs, any
+ * other job when no exclusive job runs or waits. slot_finished(exclusive) when it has ended. */
+int slot_try_start(int exclusive);
+void slot_finished(int exclusive);
+
 #endif
