@@ -228,7 +228,7 @@ install-files:
 	install -m 644 deploy/worker.env.example $(DESTDIR)$(DATADIR)/poro/examples/worker.env
 	[ -e $(DESTDIR)$(SYSCONFDIR)/poro/poro-server.conf ] || \
 		install -m 644 deploy/poro-server.conf.example $(DESTDIR)$(SYSCONFDIR)/poro/poro-server.conf
-	if [ -d web ]; then install -d $(DESTDIR)$(DATADIR)/poro/web && cp -R web/. $(DESTDIR)$(DATADIR)/poro/web/; fi
+	if [ -d web ]; then install -d $(DESTDIR)$(DATADIR)/poro/web && cp -RL web/. $(DESTDIR)$(DATADIR)/poro/web/; fi
 
 uninstall:
 	rm -f $(addprefix $(DESTDIR)$(BINDIR)/,$(INSTALL_BIN)) $(addprefix $(DESTDIR)$(UNITDIR)/,$(UNITS)) \

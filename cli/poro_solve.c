@@ -23,6 +23,10 @@
  *                                        service serves (docs/service.md §3, GET .../probes):
  *                                        {"job", "attempt", "probes": {name: {"unit", "time",
  *                                        "value"}}}, names in the order of the case, to stdout or FILE
+ *   poro-solve frames RESULT.h5 --out DIR [--job ID --attempt N]
+ *                                        every frame in the dashboard's compact form: DIR/frames.bin
+ *                                        and its index DIR/frames.json (frames_export.h); probes
+ *                                        --frames DIR writes the same beside the probes
  *   poro-solve version | --version | --help;  poro-solve COMMAND --help
  *
  * Options are parsed by getopt_long, with GNU habits: "--out DIR" and "--out=DIR", options before
@@ -62,6 +66,7 @@
 #include "case.h"
 #include "checkpoint.h"
 #include "element.h"
+#include "frames_export.h"
 #include "json_text.h"
 #include "metrics.h"
 #include "output.h"
@@ -91,6 +96,7 @@ static int parse_validate(const struct subcommand *self, int argc, char **argv);
 static int parse_element(const struct subcommand *self, int argc, char **argv);
 static int parse_report(const struct subcommand *self, int argc, char **argv);
 static int parse_probes(const struct subcommand *self, int argc, char **argv);
+static int parse_frames(const struct subcommand *self, int argc, char **argv);
 static int parse_version(const struct subcommand *self, int argc, char **argv);
 
 static const struct subcommand COMMANDS[] = {
@@ -125,12 +131,19 @@ static const struct subcommand COMMANDS[] = {
 	  "      --line-out FILE           the table of the line (needed with --line)\n"
 	  "      --at TIME                 the time of the line's frame, s\n",
 	  parse_report },
-	{ "probes", "probes RESULT.h5 --job ID --attempt N [--out FILE]",
+	{ "probes", "probes RESULT.h5 --job ID --attempt N [--out FILE] [--frames DIR]",
 	  "The probe series of a run as the JSON document the job service serves (docs/service.md §3):\n"
 	  "{\"job\", \"attempt\", \"probes\": {name: {\"unit\", \"time\", \"value\"}}}, to stdout or FILE.\n"
 	  "      --job ID, --attempt N     the job and attempt the document names (whole numbers >= 0)\n"
-	  "  -o, --out FILE                where to write it (nothing is left there on failure)\n",
+	  "  -o, --out FILE                where to write it (nothing is left there on failure)\n"
+	  "      --frames DIR              also write DIR/frames.bin and DIR/frames.json (as 'frames')\n",
 	  parse_probes },
+	{ "frames", "frames RESULT.h5 --out DIR [--job ID --attempt N]",
+	  "Every frame of a run in the dashboard's compact form (docs/web.md, \"Frames\"): DIR/frames.bin,\n"
+	  "the points' positions and fields as 32-bit floats, and its index DIR/frames.json.\n"
+	  "  -o, --out DIR                 the directory to write them in (required)\n"
+	  "      --job ID, --attempt N     the job and attempt the index names (default 0)\n",
+	  parse_frames },
 	{ "version", "version", "Prints \"poro-solve VERSION\" (git describe of the build).\n", parse_version },
 };
 static const int COMMAND_COUNT = (int)(sizeof COMMANDS / sizeof COMMANDS[0]);
@@ -623,8 +636,10 @@ static enum poro_status write_probes(FILE *f, struct results *res, const struct 
 }
 
 /* probes RESULT.h5: the whole document, or nothing (an --out FILE is removed) when the file cannot be
- * read. The case comes from the file itself, so its probe order is the run's. */
-static int cmd_probes(const char *path, long long job, long long attempt, const char *out)
+ * read. The case comes from the file itself, so its probe order is the run's. FILE is written as
+ * FILE.tmp and renamed, so it is whole whenever it exists: a worker that had to kill this process
+ * while it wrote the frames after it still has complete probes. */
+static int cmd_probes(const char *path, long long job, long long attempt, const char *out, const char *frames)
 {
 	struct poro_error err = {0};
 	struct results *res = NULL;
@@ -639,7 +654,10 @@ static int cmd_probes(const char *path, long long job, long long attempt, const 
 	if (!st && !is_element)
 		st = case_load_string(results_case_json(res), &c, &err);
 	FILE *f = NULL;
-	if (!st && !(f = out ? create_output(out) : stdout)) {
+	char tmp[4200] = "";
+	if (out)
+		snprintf(tmp, sizeof tmp, "%s.tmp", out);
+	if (!st && !(f = out ? create_output(tmp) : stdout)) {
 		results_close(&res);
 		case_destroy(&c);
 		return poro_status_exit_code(PORO_EIO);
@@ -655,12 +673,20 @@ static int cmd_probes(const char *path, long long job, long long attempt, const 
 			st = poro_error_set(&err, PORO_EIO, "cannot write '%s': %s", out ? out : "stdout", strerror(errno));
 	}
 	if (out && f && fclose(f) != 0 && !st)
-		st = poro_error_set(&err, PORO_EIO, "cannot write '%s': %s", out, strerror(errno));
+		st = poro_error_set(&err, PORO_EIO, "cannot write '%s': %s", tmp, strerror(errno));
+	if (!st && out && f && rename(tmp, out) != 0)
+		st = poro_error_set(&err, PORO_EIO, "cannot rename '%s' to '%s': %s", tmp, out, strerror(errno));
 	if (st && out && f)
-		remove(out);
+		remove(tmp);
 	results_close(&res);
 	case_destroy(&c);
-	return st ? fail(st, &err, path) : 0;
+	if (st)
+		return fail(st, &err, path);
+	/* the frames are the dashboard's and do not hold up the probes: a failure is said, and the
+	 * probes stand (frames_export leaves no frames file behind) */
+	if (frames && (st = frames_export(path, frames, job, attempt, &err)))
+		fprintf(stderr, "poro-solve: no frames written in '%s': %s\n", frames, err.message);
+	return 0;
 }
 
 /* An integer option value in [0, 10^18]; -1 after saying why not. */
@@ -676,32 +702,62 @@ static int parse_count(const char *key, const char *text, long long *value)
 	return 0;
 }
 
-/* probes RESULT.h5 --job ID --attempt N [--out FILE]. */
-static int parse_probes(const struct subcommand *self, int argc, char **argv)
+/* The options of probes and frames: --job, --attempt, --out and (probes) --frames; 0, -1 after
+ * printing the help (exit 0), or an exit status after saying why. */
+struct extract_options {
+	long long job, attempt;
+	const char *out, *frames;
+};
+
+static int parse_extract(const struct subcommand *self, int argc, char **argv, int with_frames,
+			 struct extract_options *o)
 {
 	static const struct option opts[] = {
 		{ "job", required_argument, NULL, 'j' }, { "attempt", required_argument, NULL, 'a' },
-		{ "out", required_argument, NULL, 'o' }, { "help", no_argument, NULL, 'h' }, { NULL, 0, NULL, 0 }
+		{ "out", required_argument, NULL, 'o' }, { "frames", required_argument, NULL, 'f' },
+		{ "help", no_argument, NULL, 'h' }, { NULL, 0, NULL, 0 }
 	};
-	long long job = -1, attempt = -1;
-	const char *out = NULL;
-	int c, rc;
+	int c;
 	while ((c = getopt_long(argc, argv, "ho:", opts, NULL)) != -1) {
 		if (c == 'h')
-			return subcommand_help(PROGRAM, self);
+			return subcommand_help(PROGRAM, self) == 0 ? -1 : 2;
 		else if (c == 'o')
-			out = optarg;
+			o->out = optarg;
+		else if (c == 'f' && with_frames)
+			o->frames = optarg;
 		else if (c == 'j' || c == 'a') {
-			if (parse_count(c == 'j' ? "--job" : "--attempt", optarg, c == 'j' ? &job : &attempt))
+			if (parse_count(c == 'j' ? "--job" : "--attempt", optarg, c == 'j' ? &o->job : &o->attempt))
 				return 2;
 		} else
 			return subcommand_usage_error(PROGRAM, self, NULL);
 	}
-	if ((rc = subcommand_positional(PROGRAM, self, argc, argv, 1, "RESULT.h5")))
-		return rc;
-	if (job < 0 || attempt < 0)
-		return subcommand_usage_error(PROGRAM, self, "missing %s", job < 0 ? "--job ID" : "--attempt N");
-	return cmd_probes(argv[optind], job, attempt, out);
+	return subcommand_positional(PROGRAM, self, argc, argv, 1, "RESULT.h5");
+}
+
+/* probes RESULT.h5 --job ID --attempt N [--out FILE] [--frames DIR]. */
+static int parse_probes(const struct subcommand *self, int argc, char **argv)
+{
+	struct extract_options o = { -1, -1, NULL, NULL };
+	int rc = parse_extract(self, argc, argv, 1, &o);
+	if (rc)
+		return rc < 0 ? 0 : rc;
+	if (o.job < 0 || o.attempt < 0)
+		return subcommand_usage_error(PROGRAM, self, "missing %s", o.job < 0 ? "--job ID" : "--attempt N");
+	return cmd_probes(argv[optind], o.job, o.attempt, o.out, o.frames);
+}
+
+/* frames RESULT.h5 --out DIR [--job ID --attempt N]. */
+static int parse_frames(const struct subcommand *self, int argc, char **argv)
+{
+	struct extract_options o = { 0, 0, NULL, NULL };
+	int rc = parse_extract(self, argc, argv, 0, &o);
+	if (rc)
+		return rc < 0 ? 0 : rc;
+	if (!o.out)
+		return subcommand_usage_error(PROGRAM, self, "missing --out DIR");
+	struct poro_error err = { 0 };
+	enum poro_status st = frames_export(argv[optind], o.out, o.job, o.attempt, &err);
+	return st ? fail(st, &err, argv[optind]) : 0;
 }
 
 int main(int argc, char **argv)

@@ -30,6 +30,8 @@ packages=(
   systemd               # systemd-analyze: tests/install/install_test.sh verifies the installed units
                         # (no systemd needs to run for that)
   man-db                # man -l: the same test renders the installed man pages
+  chromium fonts-dejavu-core  # the dashboard's browser tests (tests/web): Debian's headless chromium,
+                        # driven by playwright-core; no browser is ever downloaded
 )
 
 # `deps.sh fuzz` (make fuzz) adds what the fuzzers build with: clang with libFuzzer and its
@@ -55,8 +57,33 @@ install_linter() {
   (cd "$lint_dir" && npm ci --no-audit --no-fund --loglevel=error)
 }
 
+# The dashboard's npm libraries (web/, docs/web.md), pinned in tools/web-vendor/package-lock.json:
+# npm ci there, then each library's browser files and licence are copied into web/vendor/, which
+# poro-server serves (no build step; nothing is fetched at run time). The browser tests'
+# playwright-core is pinned in tests/web/package-lock.json.
+repo="$(cd "$(dirname "$0")/.." && pwd)"
+install_web() {
+  local vendor="$repo/tools/web-vendor" tests="$repo/tests/web" dest="$repo/web/vendor/uplot"
+  if [ ! -f "$vendor/node_modules/uplot/package.json" ]; then
+    echo "deps: installing the dashboard's libraries (npm ci in tools/web-vendor)"
+    (cd "$vendor" && npm ci --no-audit --no-fund --loglevel=error)
+  fi
+  local src="$vendor/node_modules/uplot"
+  if ! cmp -s "$src/dist/uPlot.esm.js" "$dest/uPlot.esm.js" 2>/dev/null; then
+    mkdir -p "$dest"
+    cp "$src/dist/uPlot.esm.js" "$src/dist/uPlot.min.css" "$src/LICENSE" "$dest/"
+    mv "$dest/LICENSE" "$dest/LICENSE.txt"
+    node -e 'process.stdout.write(require(process.argv[1]).version + "\n")' "$src/package.json" > "$dest/VERSION.txt"
+  fi
+  if [ ! -f "$tests/node_modules/playwright-core/package.json" ]; then
+    echo "deps: installing the browser tests' playwright-core (npm ci in tests/web)"
+    (cd "$tests" && npm ci --no-audit --no-fund --loglevel=error)
+  fi
+}
+
 if [ ${#missing[@]} -eq 0 ]; then
   install_linter
+  install_web
   exit 0
 fi
 
@@ -67,3 +94,4 @@ export DEBIAN_FRONTEND=noninteractive
 $SUDO apt-get update -qq
 $SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}"
 install_linter
+install_web

@@ -9,9 +9,10 @@
  * write, only if the attempt still holds the lease (store_file_commit). A file without an index
  * row is never served. Names are checked before anything touches the disk (api_file_name).
  *
- * probes.json and metrics.json are the files whose content the server checks: probes.json is
- * served as the answer of GET /v1/jobs/{id}/probes and metrics.json read by benchmark runs
- * (bench_metrics.c), so each must be one JSON object. json_scan checks it while it streams in, in
+ * probes.json, frames.json and metrics.json are the files whose content the server checks:
+ * probes.json and frames.json are served as the answers of GET /v1/jobs/{id}/probes and
+ * GET /v1/jobs/{id}/frames (frames.c reads the latter's ranges), metrics.json is read by benchmark
+ * runs (bench_metrics.c), so each must be one JSON object. json_scan checks it while it streams in, in
  * constant memory, within JSON_FILE_MAX_BYTES (or --max-upload-bytes when smaller), a nesting depth
  * and a token length; a file that fails is 422 invalid_json_file naming the line and column, and
  * is not stored. The server never parses result files (docs/service.md §3, "Probes").
@@ -37,7 +38,7 @@
 #define ATTEMPT_MAX 1000000
 #define NAME_SIZE 129
 /* the files checked as JSON objects while they stream in */
-static const char *const JSON_FILE_NAMES[] = { "probes.json", "metrics.json", NULL };
+static const char *const JSON_FILE_NAMES[] = { "probes.json", "frames.json", "metrics.json", NULL };
 #define JSON_FILE_MAX_BYTES (256LL << 20) /* bytes: 3 probes of 2 million steps (120 bytes a step) */
 #define JSON_FILE_DEPTH_MAX 16            /* the probes document nests 4 deep */
 #define JSON_FILE_TOKEN_MAX 4096          /* bytes of one string or number */

@@ -88,6 +88,14 @@ static const struct route ROUTES[] = {
 	{ "POST", "/v1/tokens", ROLE_ADMIN, BODY_SMALL, admin_tokens_create, 0, 0, 0, 0 },
 	{ "GET", "/v1/tokens", USER_ROLES, BODY_SMALL, admin_tokens_list, 0, 0, 0, 0 },
 	{ "DELETE", "/v1/tokens/{id}", USER_ROLES, BODY_SMALL, admin_tokens_revoke, 0, 0, 0, 0 },
+	/* the dashboard (docs/web.md): its static files, and what its pages read */
+	{ "GET", "/", 0, BODY_SMALL, web_index, 0, 0, 0, 0 },
+	{ "GET", "/web/{name}", 0, BODY_SMALL, web_file, 0, 0, 0, 0 },
+	{ "POST", "/v1/cases/validate", USER_ROLES, BODY_CASE, jobs_validate, 0, 0, 0, 0 },
+	{ "GET", "/v1/jobs/{id}/case", USER_ROLES, BODY_SMALL, web_job_case, 0, 0, 0, 0 },
+	{ "GET", "/v1/jobs/{id}/frames", USER_ROLES, BODY_SMALL, frames_index, 0, 0, 0, 0 },
+	{ "GET", "/v1/jobs/{id}/frames/{frame}", USER_ROLES, BODY_SMALL, frames_get, 0, 0, 0, 0 },
+	{ "GET", "/v1/admin/workers", ROLE_ADMIN, BODY_SMALL, web_admin_workers, 0, 0, 0, 0 },
 	/* benchmark runs (bench.h): a plan names up to 500 cases, so it may be larger than a small body */
 	{ "POST", "/v1/benchmarks", USER_ROLES, BODY_CASE, bench_create, 0, 0, 0, 0 },
 	{ "GET", "/v1/benchmarks", USER_ROLES, BODY_SMALL, bench_list, 0, 0, 0, 0 },
@@ -441,12 +449,24 @@ static int match(const char *pattern, const char *path, long long *id, char **na
 			*id = v;
 			u += seg;
 			p += 4;
+		} else if (strncmp(p, "{frame}", 7) == 0) { /* a frame's number: 0 or more, one element */
+			if (seg == 0 || seg > 9 || (u[0] == '0' && seg > 1) || strspn(u, "0123456789") < seg)
+				return 0;
+			*name = strndup(u, seg);
+			if (!*name)
+				return 0;
+			u += seg;
+			p += 7;
 		} else { /* {name}: the rest of the path */
 			*name = strdup(u);
 			return *name != NULL;
 		}
 	}
-	return *u == '\0';
+	if (*u == '\0')
+		return 1;
+	free(*name); /* a {frame} matched, and the path goes on */
+	*name = NULL;
+	return 0;
 }
 
 /* Finds the route; 0, or an error code after replying (404, 405). */

@@ -15,6 +15,7 @@
  * command line is read by getopt_long (--opt=value or --opt value, abbreviations, "--"); --help
  * and --version print on stdout and exit 0, a bad command line or config file exits 2.
  */
+#include "api.h"
 #include "file_sweep.h"
 #include "http.h"
 #include "log.h"
@@ -84,6 +85,7 @@ static const struct option_def OPTIONS[] = {
 	LONG_OPT("max-log-bytes", max_log_bytes, 65536, 1LL << 50, "log text kept per attempt: its first and last half (default 67108864)"),
 	LONG_OPT("user-max-stored-bytes", user_max_stored_bytes, 0, 1LL << 60, "default per-user cap on stored bytes (cases, logs, files), 0 = unlimited (default 2147483648)"),
 	INT_OPT("min-free-mb", min_free_mb, 0, 1 << 30, "/healthz is degraded below this free space on the state file system, MiB (default 64)"),
+	TEXT_OPT("web-root", "DIR", web_root, "the dashboard's files (default BINDIR/../share/poro/web, else BINDIR/../web)"),
 };
 #define OPTION_COUNT (sizeof OPTIONS / sizeof OPTIONS[0])
 
@@ -390,6 +392,8 @@ int main(int argc, char **argv)
 	static struct server srv;
 	if (parse_args(&srv.cfg, argc, argv) != 0)
 		return 2;
+	if (!srv.cfg.web_root[0])
+		web_root_default(srv.cfg.web_root, sizeof srv.cfg.web_root);
 	pthread_mutex_init(&srv.wake_lock, NULL);
 	pthread_cond_init(&srv.claim_cv, NULL);
 	pthread_cond_init(&srv.log_cv, NULL);

@@ -189,6 +189,13 @@ static const char *const MIGRATIONS[] = {
 	"  stats TEXT,"                          /* JSON: the rank test's figures */
 	"  PRIMARY KEY (run_id, figure)) WITHOUT ROWID;"
 	"CREATE INDEX benchmark_series ON benchmark_figures (suite, figure, fingerprint, run_id);",
+	/* 5: the dashboard's job search (store_search.c): the case's title beside the job, kept at
+	 * submission, and two covering indexes, so that a filter on state, dates, the job's name or
+	 * the case's title reads index entries alone, never a job's case text */
+	"ALTER TABLE jobs ADD COLUMN case_title TEXT;"
+	"UPDATE jobs SET case_title = json_extract(case_json, '$.title') WHERE json_valid(case_json);"
+	"CREATE INDEX jobs_user_search ON jobs (user_id, id, state, created_at, name, case_title);"
+	"CREATE INDEX jobs_search ON jobs (id, state, created_at, user_id, name, case_title);",
 };
 
 #define MIGRATION_COUNT ((int)(sizeof MIGRATIONS / sizeof MIGRATIONS[0]))

@@ -50,6 +50,7 @@ struct server_config {
 	long long max_log_bytes;      /* log text kept per attempt: its first and last half, bytes */
 	long long user_max_stored_bytes; /* default per-user cap on stored bytes; 0 = unlimited */
 	int min_free_mb;              /* /healthz is degraded below this much free space on the state file system, MiB */
+	char web_root[SERVER_STATE_MAX]; /* the dashboard's files (docs/web.md); "" until main.c finds them */
 };
 
 /*      code                        HTTP  name on the wire */

@@ -74,6 +74,7 @@ struct job_submit {
 	const char *case_json;        /* canonical case text */
 	const char *case_sha256;
 	const char *name;             /* or NULL */
+	const char *case_title;       /* the case's "title", or NULL */
 	int priority, threads, wall_time_seconds;
 	const char *batch;            /* the benchmark run's label, or NULL (jobs_submit.h) */
 	int exclusive;                /* 1: runs alone on its worker */
@@ -91,6 +92,29 @@ enum api_code store_job_get(struct store *s, const struct principal *who, long l
  * combination is an index range scan that stops after limit + 1 rows, without a sort. */
 enum api_code store_job_list(struct store *s, const struct principal *who, unsigned states, int limit,
 			     long long after, json_t **page, struct api_error *err);
+/* The dashboard's search (store_search.c): the filters of GET /v1/jobs beyond state, limit and
+ * after. Strings are NULL when not given; times are ms since the epoch, 0 when not given. */
+struct job_search {
+	unsigned states;              /* JOB_STATE_* bit mask, 0 = all */
+	const char *user;             /* the owner's name (admins; a user sees only its own jobs) */
+	const char *name;             /* a substring of the job's name, any case */
+	const char *title;            /* a substring of the case's title, any case */
+	long long created_from, created_to; /* created_at in [from, to], ms */
+	int oldest_first;             /* 1: ascending ids (after = the last id of the previous page) */
+	int limit;
+	long long after;
+};
+/* A page of jobs by a search, as store_job_list's; each page reads one covering index range
+ * (jobs_user_search for a user, jobs_search for an admin's search of every user), the filters
+ * evaluated on index entries, so a job's case text is never read for a row that is not shown. */
+enum api_code store_job_search(struct store *s, const struct principal *who, const struct job_search *q,
+			       json_t **page, struct api_error *err);
+/* The case text of a job the principal may see, as stored (canonical JSON); the caller frees it. */
+enum api_code store_job_case(struct store *s, const struct principal *who, long long id, char **text,
+			     struct api_error *err);
+/* For the admin view: {"running": [job...]} the running jobs, and "queue": [{"user", "queued",
+ * "running", "max_queued", "max_running"}] the users with queued or running jobs. */
+enum api_code store_admin_overview(struct store *s, json_t **out, struct api_error *err);
 /* Cancels a queued job now, or requests cancel of a running one. API_NOT_CANCELLABLE. */
 enum api_code store_job_cancel(struct store *s, const struct principal *who, long long id, json_t **job,
 			       struct api_error *err);

@@ -108,6 +108,8 @@ json_t *job_from_row(struct store *s, sqlite3_stmt *st)
 	/* the benchmark nightlies' batch label and exclusive flag (docs/benchmarks.md) */
 	json_object_set_new(job, "batch", col_json_text(st, 21));
 	json_object_set_new(job, "exclusive", json_boolean(sqlite3_column_int(st, 22)));
+	/* the case's title, kept beside the job for the dashboard's search (store_search.c) */
+	json_object_set_new(job, "case_title", col_json_text(st, 23));
 	return job;
 }
 
@@ -341,8 +343,8 @@ static enum api_code submit_run(struct store *s, struct conn *c, void *arg, stru
 	    (rc = next_job_id(c, &id, err)) != API_OK)
 		return rc;
 	sqlite3_stmt *st = conn_stmt(c, "INSERT INTO jobs (user_id, name, state, priority, threads, wall_time_seconds,"
-					" case_json, case_sha256, created_at, queued_at, id, stored_bytes, batch, exclusive)"
-					" VALUES (?1, ?2, 'queued', ?3, ?4, ?5, ?6, ?7, ?8, ?8, ?9, ?10, ?11, ?12)");
+					" case_json, case_sha256, created_at, queued_at, id, stored_bytes, batch, exclusive, case_title)"
+					" VALUES (?1, ?2, 'queued', ?3, ?4, ?5, ?6, ?7, ?8, ?8, ?9, ?10, ?11, ?12, ?13)");
 	if (!st)
 		return db_fail(c, err, "preparing a job insert");
 	sqlite3_bind_int64(st, 9, id);
@@ -350,6 +352,8 @@ static enum api_code submit_run(struct store *s, struct conn *c, void *arg, stru
 	if (in->batch)
 		sqlite3_bind_text(st, 11, in->batch, -1, SQLITE_STATIC);
 	sqlite3_bind_int(st, 12, in->exclusive != 0);
+	if (in->case_title)
+		sqlite3_bind_text(st, 13, in->case_title, -1, SQLITE_STATIC);
 	sqlite3_bind_int64(st, 1, in->who->user_id);
 	if (in->name)
 		sqlite3_bind_text(st, 2, in->name, -1, SQLITE_STATIC);

@@ -81,7 +81,7 @@ void worker_claim(struct request *r)
 	struct job_claim in = { .who = &r->who, .worker = worker, .host = host ? host : worker,
 				.exclusive_ok = json_is_true(exclusive) };
 	long long deadline = now_ms() + 1000 * wait;
-	metrics_worker_seen(srv->metrics, worker, r->who.name);
+	metrics_worker_claim(srv->metrics, worker, r->who.name, in.host, (int)threads, 1);
 	server_worker_seen(srv);
 	atomic_fetch_add(&srv->claims_waiting, 1);
 	for (;;) {
@@ -110,6 +110,7 @@ void worker_claim(struct request *r)
 		wait_for_work(srv, seq, deadline);
 	}
 	atomic_fetch_sub(&srv->claims_waiting, 1);
+	metrics_worker_claim(srv->metrics, worker, r->who.name, in.host, (int)threads, -1);
 	server_worker_seen(srv);
 	json_decref(body);
 }

@@ -33,7 +33,7 @@ if [ "$mode" = test ]; then
 	for t in "$build"/tests/verify/*_test "$build"/tests/solver/*_test "$build"/tests/common/*_test; do
 		[ -x "$t" ] && parallel+=("$t")
 	done
-	for t in tests/cli/*_test.sh tests/install/*_test.sh; do [ -f "$t" ] && serial+=("bash $t $build"); done
+	for t in tests/cli/*_test.sh tests/install/*_test.sh tests/web/*_test.sh; do [ -f "$t" ] && serial+=("bash $t $build"); done
 	# fault injection, power loss and the short soak (docs/hardening.md)
 	for t in tests/fault/*_test.sh; do [ -f "$t" ] && serial+=("bash $t $build"); done
 elif [ "$mode" = service ]; then

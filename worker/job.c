@@ -14,8 +14,9 @@
  * get there turns "succeeded" into "failed" when the server refused it (413, 422: a retry would end
  * the same way) or "infrastructure" when it kept failing until WORKER_FINISH_PATIENCE ran out; the
  * job directory is then kept, whatever --keep-work says, and the message says where. Each staged
- * result.h5 gets its probes.json from a `poro-solve probes` child (probes.h), uploaded right after
- * it; a failed extraction costs only the probes.
+ * result.h5 gets its probes.json, and the dashboard's frames.bin and frames.json, from a
+ * `poro-solve probes` child (probes.h), uploaded right after it; a failed extraction costs only
+ * those derived files.
  */
 #define _GNU_SOURCE
 #include "job.h"
@@ -44,9 +45,12 @@
 /* Seconds the finish call still gets when the final uploads used up WORKER_FINISH_PATIENCE: an
  * attempt whose files could not be sent is reported, not left to expire. */
 #define JOB_REPORT_PATIENCE 60.0
-/* Files a finish declares: result.h5, probes.json, metrics.json, result.xdmf, checkpoint.h5. */
-#define JOB_ARTIFACTS_MAX 5
+/* Files a finish declares: result.h5, probes.json, frames.bin, frames.json, metrics.json,
+ * result.xdmf, checkpoint.h5. */
+#define JOB_ARTIFACTS_MAX 7
 #define JOB_PROBES_NAME "probes.json"
+#define JOB_FRAMES_BIN "frames.bin"      /* the frames in the dashboard's compact form (probes.h) */
+#define JOB_FRAMES_INDEX "frames.json"   /* their index, uploaded after frames.bin */
 #define JOB_TEXT_MAX 8192   /* bytes of a message about the files, as the server's MESSAGE_MAX */
 
 enum stop_reason { STOP_NONE, STOP_CANCEL, STOP_WALL, STOP_SHUTDOWN, STOP_LOST };
@@ -92,7 +96,7 @@ struct job {
 	double next_heartbeat_at;
 	int checkpoints_seen;
 	/* result.h5 goes first, so it is never older; its probes.json follows once extracted */
-	struct staged up_result, up_checkpoint, up_probes;
+	struct staged up_result, up_checkpoint, up_probes, up_frames_bin, up_frames_index;
 	struct probes_run probes;
 	char upload_why[700];    /* the answer (or transport error) of the last failed upload */
 
@@ -245,12 +249,26 @@ static int stage(struct job *j, const char *name, struct staged *f, int snapshot
 static void start_probes(struct job *j, const char *result, char *note, size_t note_size)
 {
 	char err[700];
-	j->up_probes.pending = 0;
+	j->up_probes.pending = j->up_frames_bin.pending = j->up_frames_index.pending = 0;
 	if (probes_start(&j->probes, j->dir, result, j->id, j->attempt, err, sizeof err) == 0)
 		return;
 	worker_say("%s: no probes.json for '%s': cannot start poro-solve probes: %s", j->tag, result, err);
 	if (note)
 		snprintf(note, note_size, "no probes.json: cannot start poro-solve probes: %s", err);
+}
+
+/* Stages the frames the extraction wrote beside probes.json, when it wrote them (derived data:
+ * a job without them only has no field viewer). */
+static void stage_frames(struct job *j)
+{
+	struct staged *f[2] = { &j->up_frames_bin, &j->up_frames_index };
+	const char *name[2] = { PROBES_FRAMES_BIN, PROBES_FRAMES_INDEX };
+	for (int i = 0; i < 2; i++) {
+		snprintf(f[i]->path, sizeof f[i]->path, "%s/%s", j->dir, name[i]);
+		f[i]->pending = digest_file_hex(f[i]->path, f[i]->sha256, &f[i]->size) == 0;
+	}
+	if (!f[1]->pending)   /* an index without its frames, or frames without an index, is of no use */
+		f[0]->pending = 0;
 }
 
 /* Polls the extraction: PROBES_DONE with probes.json staged in f; PROBES_FAILED said, and kept in
@@ -261,6 +279,7 @@ static enum probes_state collect_probes(struct job *j, struct staged *f, double 
 	enum probes_state st = probes_poll(&j->probes, now, why, sizeof why);
 	if (st == PROBES_DONE) {
 		snprintf(f->path, sizeof f->path, "%s/%s", j->dir, PROBES_OUT);
+		stage_frames(j);
 		if (digest_file_hex(f->path, f->sha256, &f->size) == 0) {
 			f->pending = 1;
 		} else {
@@ -269,6 +288,12 @@ static enum probes_state collect_probes(struct job *j, struct staged *f, double 
 		}
 	}
 	if (st == PROBES_FAILED) {
+		snprintf(f->path, sizeof f->path, "%s/%s", j->dir, PROBES_OUT);
+		if (digest_file_hex(f->path, f->sha256, &f->size) == 0) {   /* whole (probes.h): the frames failed */
+			worker_say("%s: no frames for this result.h5: %s", j->tag, why);
+			f->pending = 1;
+			return PROBES_DONE;
+		}
 		worker_say("%s: no probes.json for this result.h5: %s", j->tag, why);
 		if (note)
 			snprintf(note, note_size, "no probes.json: %s", why);
@@ -295,6 +320,10 @@ static void checkpoint_uploads(struct job *j, double now)
 	if (j->up_result.pending && upload(j, "result.h5", &j->up_result) != SEND_OK)
 		return;
 	if (j->up_probes.pending && upload(j, JOB_PROBES_NAME, &j->up_probes) != SEND_OK)
+		return;
+	if (j->up_frames_bin.pending && upload(j, JOB_FRAMES_BIN, &j->up_frames_bin) != SEND_OK)
+		return;
+	if (j->up_frames_index.pending && upload(j, JOB_FRAMES_INDEX, &j->up_frames_index) != SEND_OK)
 		return;
 	if (j->up_checkpoint.pending && upload(j, "checkpoint.h5", &j->up_checkpoint) == SEND_OK)
 		worker_say("%s: checkpoint uploaded", j->tag);
@@ -480,6 +509,8 @@ static void upload_final(struct job *j, const char *name, struct staged *f, doub
 		snprintf(j->probes_note, sizeof j->probes_note, "no probes.json: %s", text);
 		return;
 	}
+	if (!strcmp(name, JOB_FRAMES_BIN) || !strcmp(name, JOB_FRAMES_INDEX))
+		return;   /* the dashboard's frames: derived, like the probes; said in the worker's line above */
 	j->keep = 1;
 	if (!j->problem[0]) {
 		snprintf(j->problem, sizeof j->problem, "%s", text);
@@ -506,17 +537,22 @@ static int final_probes(struct job *j, struct staged *f, double deadline)
 static void final_uploads(struct job *j, double deadline)
 {
 	/* declared[] has room for each of them */
-	static const char *const names[JOB_ARTIFACTS_MAX] = {"result.h5", JOB_PROBES_NAME, "metrics.json",
-							     "result.xdmf", "checkpoint.h5"};
+	static const char *const names[JOB_ARTIFACTS_MAX] = {"result.h5", JOB_PROBES_NAME, JOB_FRAMES_BIN,
+							     JOB_FRAMES_INDEX, "metrics.json", "result.xdmf",
+							     "checkpoint.h5"};
 	/* a checkpoint announced but not yet sent goes first, as during the run */
 	while ((j->up_result.pending || j->up_checkpoint.pending) && wait_retry(j, &j->up_b, deadline))
 		checkpoint_uploads(j, worker_now());
 	probes_stop(&j->probes);   /* the final result supersedes a snapshot's extraction */
-	j->up_probes.pending = 0;
+	j->up_probes.pending = j->up_frames_bin.pending = j->up_frames_index.pending = 0;
 	for (size_t i = 0; i < sizeof names / sizeof *names && j->stop != STOP_LOST; i++) {
 		struct staged f = {0};
 		if (!strcmp(names[i], JOB_PROBES_NAME)) {
 			if (final_probes(j, &f, deadline) < 0)
+				continue;
+		} else if (!strcmp(names[i], JOB_FRAMES_BIN) || !strcmp(names[i], JOB_FRAMES_INDEX)) {
+			f = i == 2 ? j->up_frames_bin : j->up_frames_index;   /* staged with the probes */
+			if (!f.pending)
 				continue;
 		} else if (stage(j, names[i], &f, 0) < 0) {
 			if (i == 0)

@@ -61,7 +61,7 @@ cat > "$tmp/want.txt" <<'EOF'
 644 usr/share/poro/schemas/results.md
 644 usr/share/poro/schemas/suite.schema.json
 EOF
-[ -d web ] && (cd web && find . -type f | sed 's|^\./|644 usr/share/poro/web/|') >> "$tmp/want.txt"
+[ -d web ] && (cd web && find -L . -type f | sed 's|^\./|644 usr/share/poro/web/|') >> "$tmp/want.txt"
 # every file, and the directories of etc/ (an installed directory of its own there)
 (cd "$root" && { find . -type f; find ./etc -mindepth 1 -type d; } | sed 's|^\./||' | sort |
 	while read -r f; do echo "$(stat -c %a "$f") $f"; done) > "$tmp/got.txt"
@@ -132,6 +132,12 @@ check completion_poro_completes $? "su -> '$(complete_words "$comp/poro" _poro p
 	[ "$(complete_words "$comp/poro-solve" _poro_solve poro-solve run case.json --ou)" = --out ] &&
 	[ "$(complete_words "$comp/poro-solve" _poro_solve poro-solve probes r.h5 --at)" = --attempt ]
 check completion_poro_solve_completes $? "val -> '$(complete_words "$comp/poro-solve" _poro_solve poro-solve val)'"
+# the completion offers exactly the commands poro-solve's own usage lists, so a new command cannot
+# be left out of it
+commands=$("$root/usr/bin/poro-solve" --help | sed -n 's/^\(usage:\|      \) poro-solve \([a-z]\+\).*/\2/p' | sort | tr '\n' ' ')
+offered=$(complete_words "$comp/poro-solve" _poro_solve poro-solve '' | sort | tr '\n' ' ')
+[ -n "$commands" ] && [ "$commands" = "$offered" ]
+check completion_poro_solve_offers_every_command $? "usage lists '$commands', the completion offers '$offered'"
 
 # ---- systemd ----------------------------------------------------------------------------------------
 # The units are checked as installed: in a root holding the installation and the system's own
