@@ -50,6 +50,10 @@ struct server_config {
 	long long max_log_bytes;      /* log text kept per attempt: its first and last half, bytes */
 	long long user_max_stored_bytes; /* default per-user cap on stored bytes; 0 = unlimited */
 	int min_free_mb;              /* /healthz is degraded below this much free space on the state file system, MiB */
+	char tls_listen[256];         /* HOST:PORT served over TLS (HTTPS), or "" for none */
+	char tls_cert[SERVER_STATE_MAX]; /* PEM certificate chain of --tls-listen */
+	char tls_key[SERVER_STATE_MAX];  /* PEM private key of --tls-listen */
+	int allow_plain_http;         /* 1: --listen may be a non-loopback address (listen_socket.h) */
 };
 
 /*      code                        HTTP  name on the wire */
