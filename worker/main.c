@@ -107,6 +107,8 @@ enum {
 	OPT_LEASE_RENEW,
 	OPT_NAME,
 	OPT_KEEP_WORK,
+	OPT_CA_FILE,
+	OPT_ALLOW_PLAIN_HTTP,
 	OPT_VERSION
 };
 static const struct option OPTIONS[] = {
@@ -122,6 +124,8 @@ static const struct option OPTIONS[] = {
 	{ "lease-renew", required_argument, NULL, OPT_LEASE_RENEW },
 	{ "name", required_argument, NULL, OPT_NAME },
 	{ "keep-work", required_argument, NULL, OPT_KEEP_WORK },
+	{ "ca-file", required_argument, NULL, OPT_CA_FILE },
+	{ "allow-plain-http", no_argument, NULL, OPT_ALLOW_PLAIN_HTTP },
 	{ "help", no_argument, NULL, 'h' },
 	{ "version", no_argument, NULL, OPT_VERSION },
 	{ NULL, 0, NULL, 0 },
@@ -147,6 +151,10 @@ static void help(void)
 	       "  --lease-renew=S          heartbeat every S seconds (default: a third of the lease, at most 1 s)\n"
 	       "  --name=NAME              the worker's id in claims, heartbeats and metrics (default HOST:PID)\n"
 	       "  --keep-work=yes|no       keep each job's directory after the job (default no)\n"
+	       "  --ca-file=FILE           PEM certificate authorities to verify an https server against\n"
+	       "                           (default: $PORO_CA_FILE, else the system's)\n"
+	       "  --allow-plain-http       allow an http:// server that is not on loopback: the token crosses\n"
+	       "                           the network in clear text (default: refused)\n"
 	       "  -h, --help               this text\n"
 	       "  --version                print the version\n\n"
 	       "SIGTERM or SIGINT drains (no new jobs; running ones finish); a second one stops the solvers and\n"
@@ -308,7 +316,8 @@ static int int_option(const char *name, const char *value, long lo, long hi, lon
 
 static int parse_flags(int argc, char **argv)
 {
-	const char *solver = NULL, *work = "var/work", *name = NULL, *token_file = NULL;
+	const char *solver = NULL, *work = "var/work", *name = NULL, *token_file = NULL, *ca_file = NULL;
+	int allow_plain = 0;
 	long v, budget = 0;
 	int rc = 0, opt, index = 0;
 	worker_opt.slots = 1;
@@ -345,6 +354,8 @@ static int parse_flags(int argc, char **argv)
 				rc = bad_usage("--keep-work must be yes or no, got '%s'", optarg);
 			worker_opt.keep_work = !strcmp(optarg, "yes");
 			break;
+		case OPT_CA_FILE: ca_file = optarg; break;
+		case OPT_ALLOW_PLAIN_HTTP: allow_plain = 1; break;
 		case 'h': help(); exit(0);
 		case OPT_VERSION: printf("poro-worker %s\n", PORO_VERSION); exit(0);
 		case ':': rc = bad_usage("option '%s' needs a value", argv[optind - 1]); break;
@@ -362,7 +373,8 @@ static int parse_flags(int argc, char **argv)
 	if (token_file && read_token_file(token_file, worker_opt.token, sizeof worker_opt.token) != 0)
 		return 2;
 	char err[1200] = "";
-	struct client_config cfg = {0};
+	struct client_config cfg = { .allow_plain_http = allow_plain };
+	snprintf(cfg.ca_file, sizeof cfg.ca_file, "%s", ca_file ? ca_file : "");
 	snprintf(cfg.server, sizeof cfg.server, "%s", worker_opt.server);
 	snprintf(cfg.token, sizeof cfg.token, "%s", worker_opt.token);
 	if (client_config_load(&cfg, err, sizeof err) < 0) {
@@ -376,6 +388,11 @@ static int parse_flags(int argc, char **argv)
 		fprintf(stderr, "poro-worker: no server URL or token (--server/--token, PORO_SERVER/PORO_TOKEN)\n");
 		return 2;
 	}
+	if (client_config_check_server(&cfg, err, sizeof err) != 0) {
+		fprintf(stderr, "poro-worker: %s\n", err);
+		return 2;
+	}
+	snprintf(worker_opt.ca_file, sizeof worker_opt.ca_file, "%s", cfg.ca_file);
 	if (find_solver(solver, worker_opt.solver, sizeof worker_opt.solver) < 0) {
 		fprintf(stderr, "poro-worker: cannot find an executable poro-solve%s%s\n", solver ? " at " : "",
 			solver ? solver : "");
@@ -439,6 +456,7 @@ int main(int argc, char **argv)
 		fprintf(stderr, "poro-worker: cannot initialise libcurl\n");
 		return 1;
 	}
+	http_global_ca_file(worker_opt.ca_file);
 	signal(SIGPIPE, SIG_IGN);
 	sigset_t set;
 	sigemptyset(&set);

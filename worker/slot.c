@@ -3,7 +3,8 @@
  * repeat until the worker drains. Each slot has two clients: the claim client aborts its long-poll
  * at once when the worker drains; the job client never aborts, so a draining worker still delivers
  * its running jobs' logs, files and outcomes. A claim that fails for want of a server is retried
- * with backoff; a refused token ends the worker.
+ * with backoff; a refused token, or a server whose TLS certificate cannot be verified, ends the
+ * worker.
  */
 #include <stdio.h>
 #include <string.h>
@@ -46,8 +47,10 @@ void *slot_main(void *arg)
 			job_run(runner, json_object_get(r.json, "job"));
 		} else if (status == 204) {
 			backoff_reset(&b);
-		} else if (status == 401 || status == 403) {
-			worker_say("claim refused, stopping: %s", http_describe(&r, why, sizeof why));
+		} else if (status == 401 || status == 403 || r.tls_unverified) {
+			/* a refused token or an unverifiable server stays so: retrying would only hide it */
+			worker_say("%s, stopping: %s", r.tls_unverified ? "server not trusted" : "claim refused",
+				   http_describe(&r, why, sizeof why));
 			atomic_store(&worker_fatal, 1);
 			atomic_store(&worker_draining, 1);
 		} else {

@@ -42,6 +42,7 @@
 struct worker_options {
 	char server[1024];       /* base URL */
 	char token[512];         /* worker token */
+	char ca_file[1024];      /* PEM certificate authorities for an https server, "" for the system's */
 	int slots;               /* jobs run at once */
 	char work[4096];         /* absolute directory holding job-<id>-<attempt>/ */
 	char solver[4096];       /* absolute path of poro-solve */
