@@ -14,6 +14,8 @@ packages=(
   libmicrohttpd-dev     # server HTTP; Debian's libmicrohttpd12 is built with GnuTLS (--tls-listen)
   openssl               # tests/service/tls_test.sh makes its certificate authority with it
   iproute2              # ... and its two hosts with ip netns and a veth pair
+  slurmctld slurmd slurm-client munge  # tests/service/slurm_test.sh starts a one-node Slurm of its
+                        # own (no systemd; the packages' services are not used) for the pilots
   libsqlite3-dev        # server store
   sqlite3               # the sqlite3 shell, used by the service tests
   libcurl4-openssl-dev  # worker and CLI HTTP client

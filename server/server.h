@@ -24,6 +24,12 @@
 #define SERVER_MESSAGE_MAX 1024
 
 /* Configuration; defaults in main.c (CONFIG_DEFAULTS) and in `poro-server --help`. */
+/* A job's wall time when its submission names none, s. A claim with seconds_left (a pilot) is given
+ * a job only when the job's wall time fits, except a job with this default: it asked for no
+ * particular time, so any pilot may start it and, when its time runs out first, hand it back with
+ * a checkpoint for the next to resume (docs/slurm.md). */
+#define JOB_WALL_TIME_DEFAULT 86400
+
 struct server_config {
 	char listen[256];             /* HOST:PORT; port 0 picks a free one */
 	char state[SERVER_STATE_MAX];  /* state directory: poro.db, files/, server.url */

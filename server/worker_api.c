@@ -56,21 +56,23 @@ static void wait_for_work(struct server *srv, unsigned long long seq, long long 
 
 void worker_claim(struct request *r)
 {
-	static const char *const keys[] = { "worker", "host", "threads", "wait_seconds", NULL };
+	static const char *const keys[] = { "worker", "host", "threads", "wait_seconds", "seconds_left", NULL };
 	json_t *body = api_body_object(r);
 	if (!body)
 		return;
 	const char *worker, *host;
-	long long threads, wait;
+	long long threads, wait, seconds_left;
 	if (api_known_keys(r, body, keys) || api_string_member(r, body, "worker", SERVER_NAME_MAX, 1, &worker) ||
 	    api_string_member(r, body, "host", SERVER_NAME_MAX, 0, &host) ||
 	    api_int_member(r, body, "threads", 1, THREADS_MAX, 1, &threads) ||
-	    api_int_member(r, body, "wait_seconds", 0, WAIT_SECONDS_MAX, 0, &wait)) {
+	    api_int_member(r, body, "wait_seconds", 0, WAIT_SECONDS_MAX, 0, &wait) ||
+	    api_int_member(r, body, "seconds_left", 0, 1LL << 40, -1, &seconds_left)) {
 		json_decref(body);
 		return;
 	}
 	struct server *srv = r->srv;
-	struct job_claim in = { .who = &r->who, .worker = worker, .host = host ? host : worker };
+	struct job_claim in = { .who = &r->who, .worker = worker, .host = host ? host : worker,
+				.seconds_left = seconds_left };
 	long long deadline = now_ms() + 1000 * wait;
 	metrics_worker_seen(srv->metrics, worker, r->who.name);
 	server_worker_seen(srv);

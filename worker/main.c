@@ -82,6 +82,19 @@ double worker_now(void)
 	return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
 }
 
+int worker_retire_due(double now, double fraction)
+{
+	return worker_opt.end_at > 0 && now >= worker_opt.end_at - fraction * (double)worker_opt.retire_margin;
+}
+
+long worker_seconds_left(double now)
+{
+	if (worker_opt.end_at <= 0)
+		return -1;
+	double left = worker_opt.end_at - (double)worker_opt.retire_margin - now;
+	return left > 0 ? (long)left : 0;
+}
+
 void worker_sleep(double seconds, int wake_on_drain)
 {
 	double end = worker_now() + seconds;
@@ -109,6 +122,9 @@ enum {
 	OPT_KEEP_WORK,
 	OPT_CA_FILE,
 	OPT_ALLOW_PLAIN_HTTP,
+	OPT_LIFETIME,
+	OPT_RETIRE_MARGIN,
+	OPT_IDLE_EXIT,
 	OPT_VERSION
 };
 static const struct option OPTIONS[] = {
@@ -126,6 +142,9 @@ static const struct option OPTIONS[] = {
 	{ "keep-work", required_argument, NULL, OPT_KEEP_WORK },
 	{ "ca-file", required_argument, NULL, OPT_CA_FILE },
 	{ "allow-plain-http", no_argument, NULL, OPT_ALLOW_PLAIN_HTTP },
+	{ "lifetime", required_argument, NULL, OPT_LIFETIME },
+	{ "retire-margin", required_argument, NULL, OPT_RETIRE_MARGIN },
+	{ "idle-exit", required_argument, NULL, OPT_IDLE_EXIT },
 	{ "help", no_argument, NULL, 'h' },
 	{ "version", no_argument, NULL, OPT_VERSION },
 	{ NULL, 0, NULL, 0 },
@@ -155,6 +174,12 @@ static void help(void)
 	       "                           (default: $PORO_CA_FILE, else the system's)\n"
 	       "  --allow-plain-http       allow an http:// server that is not on loopback: the token crosses\n"
 	       "                           the network in clear text (default: refused)\n"
+	       "  --lifetime=S             the worker's allocation ends S seconds from its start (a Slurm\n"
+	       "                           pilot's time limit): it claims only jobs whose wall time fits\n"
+	       "                           what is left, and hands running jobs back with a checkpoint\n"
+	       "                           --retire-margin seconds before the end (default: no end)\n"
+	       "  --retire-margin=S        (default 60)\n"
+	       "  --idle-exit=S            exit after S seconds without a job; 0 = never (default 0)\n"
 	       "  -h, --help               this text\n"
 	       "  --version                print the version\n\n"
 	       "SIGTERM or SIGINT drains (no new jobs; running ones finish); a second one stops the solvers and\n"
@@ -318,6 +343,8 @@ static int parse_flags(int argc, char **argv)
 {
 	const char *solver = NULL, *work = "var/work", *name = NULL, *token_file = NULL, *ca_file = NULL;
 	int allow_plain = 0;
+	long lifetime = 0;
+	worker_opt.retire_margin = WORKER_RETIRE_MARGIN;
 	long v, budget = 0;
 	int rc = 0, opt, index = 0;
 	worker_opt.slots = 1;
@@ -356,6 +383,9 @@ static int parse_flags(int argc, char **argv)
 			break;
 		case OPT_CA_FILE: ca_file = optarg; break;
 		case OPT_ALLOW_PLAIN_HTTP: allow_plain = 1; break;
+		case OPT_LIFETIME: rc = int_option(o, optarg, 1, 1L << 30, &lifetime); break;
+		case OPT_RETIRE_MARGIN: rc = int_option(o, optarg, 1, 1L << 30, &worker_opt.retire_margin); break;
+		case OPT_IDLE_EXIT: rc = int_option(o, optarg, 0, 1L << 30, &worker_opt.idle_exit); break;
 		case 'h': help(); exit(0);
 		case OPT_VERSION: printf("poro-worker %s\n", PORO_VERSION); exit(0);
 		case ':': rc = bad_usage("option '%s' needs a value", argv[optind - 1]); break;
@@ -364,6 +394,11 @@ static int parse_flags(int argc, char **argv)
 	}
 	if (rc)
 		return rc;
+	if (lifetime > 0 && lifetime <= worker_opt.retire_margin)
+		return bad_usage("--lifetime (%ld s) must be longer than --retire-margin (%ld s)", lifetime,
+				 worker_opt.retire_margin);
+	if (lifetime > 0)
+		worker_opt.end_at = worker_now() + (double)lifetime;
 	if (optind < argc)
 		return bad_usage("unexpected argument '%s'", argv[optind]);
 	if (token_file && worker_opt.token[0]) {

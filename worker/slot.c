@@ -14,10 +14,36 @@
 #include "job.h"
 #include "worker.h"
 
-static json_t *claim_body(void)
+/* The claim: with a lifetime it says how many seconds a job may still run here (the server
+ * gives only jobs whose wall_time_seconds fit), and with --idle-exit it waits no longer than the
+ * idle time left. */
+static json_t *claim_body(double now, double idle_since)
 {
-	return json_pack("{s:s, s:s, s:i, s:i}", "worker", worker_opt.name, "host", worker_opt.host, "threads",
-			 worker_opt.threads, "wait_seconds", WORKER_CLAIM_WAIT);
+	int wait = WORKER_CLAIM_WAIT;
+	if (worker_opt.idle_exit > 0) {
+		double left = idle_since + (double)worker_opt.idle_exit - now;
+		wait = left < wait ? (left > 1 ? (int)left : 1) : wait;
+	}
+	json_t *body = json_pack("{s:s, s:s, s:i, s:i}", "worker", worker_opt.name, "host", worker_opt.host, "threads",
+				 worker_opt.threads, "wait_seconds", wait);
+	long left = worker_seconds_left(now);
+	if (body && left >= 0)
+		json_object_set_new(body, "seconds_left", json_integer(left));
+	return body;
+}
+
+/* 1 when the slot should claim no more: the allocation is about to end, or it idled too long. */
+static int slot_retires(int slot, double now, double idle_since)
+{
+	if (worker_retire_due(now, 1.0)) {
+		worker_say("slot %d: the allocation ends in %.0f s: claiming no more", slot, worker_opt.end_at - now);
+		return 1;
+	}
+	if (worker_opt.idle_exit > 0 && now - idle_since >= (double)worker_opt.idle_exit) {
+		worker_say("slot %d: no job for %ld s: ending (--idle-exit)", slot, worker_opt.idle_exit);
+		return 1;
+	}
+	return 0;
 }
 
 void *slot_main(void *arg)
@@ -33,11 +59,13 @@ void *slot_main(void *arg)
 		http_client_set_abort(claimer, &worker_draining);
 	}
 	struct backoff b = {0};
-	json_t *body = claim_body();
-	while (!atomic_load(&worker_draining)) {
+	double idle_since = worker_now();
+	while (!atomic_load(&worker_draining) && !slot_retires(slot, worker_now(), idle_since)) {
 		struct http_response r;
 		char why[700];
+		json_t *body = claim_body(worker_now(), idle_since);
 		long status = http_json(claimer, "POST", "/v1/worker/claim", body, NULL, WORKER_CLAIM_WAIT + 30, &r);
+		json_decref(body);
 		if (atomic_load(&worker_draining) && status == 0) {
 			http_response_release(&r);
 			break;
@@ -45,6 +73,7 @@ void *slot_main(void *arg)
 		if (status == 200 && json_is_object(json_object_get(r.json, "job"))) {
 			backoff_reset(&b);
 			job_run(runner, json_object_get(r.json, "job"));
+			idle_since = worker_now();
 		} else if (status == 204) {
 			backoff_reset(&b);
 		} else if (status == 401 || status == 403 || r.tls_unverified) {
@@ -61,7 +90,6 @@ void *slot_main(void *arg)
 		}
 		http_response_release(&r);
 	}
-	json_decref(body);
 	http_client_destroy(&claimer);
 	http_client_destroy(&runner);
 	return NULL;
