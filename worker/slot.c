@@ -24,9 +24,11 @@ static json_t *claim_body(double now, double idle_since)
 		double left = idle_since + (double)worker_opt.idle_exit - now;
 		wait = left < wait ? (left > 1 ? (int)left : 1) : wait;
 	}
+	long left = worker_seconds_left(now);
+	if (left >= 0 && left < wait)   /* a job handed in now would be handed back at once */
+		wait = left > 1 ? (int)left : 1;
 	json_t *body = json_pack("{s:s, s:s, s:i, s:i}", "worker", worker_opt.name, "host", worker_opt.host, "threads",
 				 worker_opt.threads, "wait_seconds", wait);
-	long left = worker_seconds_left(now);
 	if (body && left >= 0)
 		json_object_set_new(body, "seconds_left", json_integer(left));
 	return body;
