@@ -18,7 +18,8 @@
  *     1% of Skempton's B q, B = 1 / (1 + n m_v^-1 / K_w) (spec-001 §10.5).
  *  d. Hydrostatic: the column under its own weight (gravity ramped over 0.1 s, k = 1e-2 m/s,
  *     drained top) consolidated to rest: every point's pore pressure within 0.1% of rho_w g H of
- *     rho_w g d (spec-001 §10.6: guards p0 in Eq. 10b); the effective vertical stress against
+ *     rho_w g d (spec-001 §10.6: an initial hydrostatic field is an equilibrium of Eq. 10b); the
+ *     effective vertical stress against
  *     -(1 - n)(rho_s - rho_w) g d within 0.1% of rho_b g H on the mean over the points, and at
  *     every point within the weight of half a cell: B-bar samples the volumetric strain at the
  *     cell's centre, so in one dimension both points of a cell carry the stress of its centre,

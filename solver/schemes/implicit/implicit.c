@@ -127,8 +127,6 @@ static enum poro_status create(struct sim *s)
 		return poro_error_set(&s->err, PORO_ENOMEM, "cannot allocate the implicit scheme's arrays for %ld unknowns "
 				      "and %ld points", (long)N, (long)s->soil.n);
 	e->pressure_scale = pressure_scale(s);
-	/* Eq. 10b's reference pressure: the initial one (a checkpoint, when resuming, restores its own) */
-	memcpy(s->water.pressure0, s->water.pressure, sizeof(double) * (size_t)s->water.n);
 	return PORO_OK;
 }
 
@@ -414,12 +412,9 @@ static enum poro_status update_points(struct sim *s)
 			p->x[2 * q + c] += x_u[c];                                /* (11f) */
 		}
 		moved = fmax(moved, hypot(x_u[0], x_u[1]) * g->inv_h);
-		p->volumetric_strain[q] += eps_u;
 		e->volume_rate[q] = eps_u / dt;
-		if (q < w->n) {
-			w->volumetric_strain[q] += eps_w;
+		if (q < w->n)
 			w->pressure[q] -= e->pressure_increment[q];   /* compression positive increment */
-		}
 	}
 	e->moved_step = moved;
 	/* F from the displacement increment's gradient; V, n, k from B-bar's volumetric strain */

@@ -15,7 +15,12 @@
  *     pp:  -V S_i S_j / Q (-P, the sign spec-001 E2 restores so the matrix is symmetric)
  * and the internal forces of Eq. 10:
  *     f_u,i = V B-bar_i^T (sigma' - (1 - n) p m),   f_U,i = -V n p mB_i,
- *     f_p,i = -V S_i ((1 - n) eps_v^u + (p - p0) / Q + n eps_v^U).
+ *     f_p,i = -V S_i ((1 - n) Delta eps_v^u + Delta p / Q + n Delta eps_v^U),
+ * the last Eq. 3 integrated over the step, with the step's porosity (docs/numerics.md, "Eq. 10b
+ * over a step": spec-001 reconstructs it from the reference state, with the strains accumulated
+ * at the points since t = 0, which is exact only while n and the points' supports stay as they
+ * were, and the Xie-Leo column under 50 kPa blew up when its surface points moved into the next
+ * row of cells).
  * Stress is tension positive with engineering shear; D the elastic matrix (001 A.1f, modified
  * Newton-Raphson) or the materials' tangent.
  *
@@ -323,11 +328,10 @@ enum poro_status implicit_system_residual(struct sim *s)
 		};
 		const struct material *m = &s->materials[s->spec->bodies[p->body[q]].material];
 		status = material_update(m, &u, &s->err);
-		const double pressure = -w->pressure[q] + in.dp, p0 = -w->pressure0[q];   /* compression + */
-		const double eps_u = p->volumetric_strain[q] + in.vol_u, eps_w = w->volumetric_strain[q] + in.vol_w;
+		const double pressure = -w->pressure[q] + in.dp;   /* compression positive */
 		const double *sg = p->stress + 4 * q, pn = (1.0 - ph.n) * pressure;
 		const double partial[4] = {sg[0] - pn, sg[1] - pn, sg[2], sg[3] - pn};   /* sigma' - (1 - n) p m */
-		const double balance = (1.0 - ph.n) * eps_u + (pressure - p0) * ph.inv_Q + ph.n * eps_w;
+		const double balance = (1.0 - ph.n) * in.vol_u + in.dp * ph.inv_Q + ph.n * in.vol_w;
 		const double drag[2] = {ph.drag * (in.v_u[0] - in.v_w[0]), ph.drag * (in.v_u[1] - in.v_w[1])};
 		for (int k = 0; k < o.count; k++) {
 			double *r = e->residual + DOFS_PER_NODE * (size_t)o.node[k];
