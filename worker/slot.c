@@ -29,8 +29,11 @@ static json_t *claim_body(double now, double idle_since)
 		wait = left > 1 ? (int)left : 1;
 	json_t *body = json_pack("{s:s, s:s, s:i, s:i}", "worker", worker_opt.name, "host", worker_opt.host, "threads",
 				 worker_opt.threads, "wait_seconds", wait);
-	if (body && left >= 0)
+	if (body && left >= 0) {
+		/* a pilot's allocation is fixed: it takes only what fits in its time and cores */
 		json_object_set_new(body, "seconds_left", json_integer(left));
+		json_object_set_new(body, "max_threads", json_integer(worker_opt.threads));
+	}
 	return body;
 }
 

@@ -3,6 +3,7 @@
 # HTTP against a real poro-server and real poro-worker processes:
 #   - a claim with seconds_left gets only jobs whose wall_time_seconds fit, or that asked for
 #     none; a job asking for more stays queued until a claim with enough time comes;
+#   - a claim with max_threads gets only jobs asking for at most that many threads;
 #   - seconds_left is checked like every member (a negative one is 422 naming /seconds_left);
 #   - a worker whose --lifetime is nearly over does not take a job that asks for more, then claims
 #     nothing more and exits, saying why; one with
@@ -44,6 +45,12 @@ check claim_takes_only_jobs_that_fit "$([ "$got1" = "$fits" ] && [ "$got2" = "$a
 	"with 300 s left: got '$got1', '$got2', '$got3'; jobs: 600 s $long, 250 s $fits, none $any"
 got4=$(claim 600)
 check long_job_goes_to_a_claim_with_time "$([ "$got4" = "$long" ]; echo $?)" "with 600 s left got '$got4'"
+python3 -c "import json; d = json.load(open('$tmp/any.json')); d['threads'] = 4; json.dump(d, open('$tmp/wide.json', 'w'))"
+wide=$(submit wide)
+narrow=$(svc_req POST /v1/worker/claim "$worker" -d '{"worker": "t:1", "seconds_left": 300, "max_threads": 2}')
+wide_claim=$(svc_req POST /v1/worker/claim "$worker" -d '{"worker": "t:1", "seconds_left": 300, "max_threads": 4}' > /dev/null; json '["job"]["id"]' < "$SVC_BODY")
+check claim_takes_only_jobs_within_its_threads "$([ "$narrow" = 204 ] && [ "$wide_claim" = "$wide" ]; echo $?)" \
+	"a 4-thread job: claim with 2 threads answered $narrow, with 4 got '$wide_claim'"
 code=$(svc_req POST /v1/worker/claim "$worker" -d '{"worker": "t:1", "seconds_left": -5}')
 field=$(json '["error"]["field"]' < "$SVC_BODY")
 check negative_seconds_left_refused "$([ "$code" = 422 ] && [ "$field" = /seconds_left ]; echo $?)" "answered $code on '$field'"
