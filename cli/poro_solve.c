@@ -37,7 +37,8 @@
  * --checkpoint-wall seconds of wall time, whichever comes first, and prints
  * "checkpoint step=N time=T" after each; --resume continues from such a checkpoint, keeping the
  * frames of DIR/result.h5 up to it (checkpoint.h, docs/service.md §2). A checkpoint of another
- * case is refused with exit 2, naming the first difference.
+ * case is refused with exit 2, naming the first difference. SIGUSR1 writes a checkpoint of the
+ * current step and stops (exit 6), SIGTERM and SIGINT stop without one.
  *
  * probes runs in its own process because a result file is untrusted input for whoever reads it: the
  * worker runs it on each result.h5 it uploads, so a damaged file can crash only this process, never
@@ -81,10 +82,11 @@
 
 static volatile int stop_requested;
 
+/* SIGTERM, SIGINT: stop. SIGUSR1: write a checkpoint of the current step, then stop (a worker
+ * handing its job back before its allocation ends). */
 static void on_signal(int sig)
 {
-	(void)sig;
-	stop_requested = 1;
+	stop_requested = sig == SIGUSR1 ? SIM_STOP_CHECKPOINT : 1;
 }
 
 #define PROGRAM "poro-solve"
@@ -405,6 +407,7 @@ static int cmd_run(const char *path, const struct run_options *opt)
 		printf("resumed from '%s' at step %ld, t = %.6g s\n", opt->resume, sim_steps_taken(s), sim_time(s));
 	signal(SIGTERM, on_signal);
 	signal(SIGINT, on_signal);
+	signal(SIGUSR1, on_signal);
 	st = sim_run(s, out_dir, PORO_VERSION, print_progress, NULL, &stop_requested);
 	if (!st && sim_warning(s))   /* a failure's message quotes it already (step_health.c) */
 		printf("warning: %s\n", sim_warning(s));

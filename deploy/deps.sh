@@ -11,7 +11,11 @@ packages=(
                         # is the reference BLAS, which made the pressure solve twice as slow
                         # (docs/performance.md); the OpenMP build shares our OpenMP runtime
   libhdf5-dev hdf5-tools  # results; h5dump for inspecting
-  libmicrohttpd-dev     # server HTTP
+  libmicrohttpd-dev     # server HTTP; Debian's libmicrohttpd12 is built with GnuTLS (--tls-listen)
+  openssl               # tests/service/tls_test.sh makes its certificate authority with it
+  iproute2              # ... and its two hosts with ip netns and a veth pair
+  slurmctld slurmd slurm-client munge  # tests/service/slurm_test.sh starts a one-node Slurm of its
+                        # own (no systemd; the packages' services are not used) for the pilots
   libsqlite3-dev        # server store
   sqlite3               # the sqlite3 shell, used by the service tests
   libcurl4-openssl-dev  # worker and CLI HTTP client

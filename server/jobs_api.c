@@ -32,7 +32,7 @@
 #define PRIORITY_MAX 100
 #define THREADS_MAX 256
 #define WALL_TIME_MAX 2592000LL           /* s, 30 days */
-#define WALL_TIME_DEFAULT 86400           /* s */
+#define WALL_TIME_DEFAULT JOB_WALL_TIME_DEFAULT /* s, server.h */
 #define IDEMPOTENCY_KEY_MAX 200
 #define LIST_LIMIT_MAX 1000
 #define LIST_LIMIT_DEFAULT 100

@@ -24,6 +24,12 @@
 #define SERVER_MESSAGE_MAX 1024
 
 /* Configuration; defaults in main.c (CONFIG_DEFAULTS) and in `poro-server --help`. */
+/* A job's wall time when its submission names none, s. A claim with seconds_left (a pilot) is given
+ * a job only when the job's wall time fits, except a job with this default: it asked for no
+ * particular time, so any pilot may start it and, when its time runs out first, hand it back with
+ * a checkpoint for the next to resume (docs/slurm.md). */
+#define JOB_WALL_TIME_DEFAULT 86400
+
 struct server_config {
 	char listen[256];             /* HOST:PORT; port 0 picks a free one */
 	char state[SERVER_STATE_MAX];  /* state directory: poro.db, files/, server.url */
@@ -51,6 +57,10 @@ struct server_config {
 	long long user_max_stored_bytes; /* default per-user cap on stored bytes; 0 = unlimited */
 	int min_free_mb;              /* /healthz is degraded below this much free space on the state file system, MiB */
 	char web_root[SERVER_STATE_MAX]; /* the dashboard's files (docs/web.md); "" until main.c finds them */
+	char tls_listen[256];         /* HOST:PORT served over TLS (HTTPS), or "" for none */
+	char tls_cert[SERVER_STATE_MAX]; /* PEM certificate chain of --tls-listen */
+	char tls_key[SERVER_STATE_MAX];  /* PEM private key of --tls-listen */
+	int allow_plain_http;         /* 1: --listen may be a non-loopback address (listen_socket.h) */
 };
 
 /*      code                        HTTP  name on the wire */

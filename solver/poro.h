@@ -104,11 +104,14 @@ typedef void (*sim_progress_fn)(const struct sim_progress *p, void *user);
 
 /* Runs to the end time writing out_dir/result.h5 and result.xdmf (frames at the case's
  * frame_interval, probes every step); calls progress every progress_interval of wall time and
- * at the end. stop (may be NULL) is polled each step: non-zero interrupts with PORO_EINTERRUPTED.
+ * at the end. stop (may be NULL) is polled each step: non-zero interrupts with PORO_EINTERRUPTED;
+ * SIM_STOP_CHECKPOINT writes a checkpoint of the current step first, so that the run can be
+ * resumed elsewhere without losing work (a worker whose allocation ends hands its job back so).
  * Writes out_dir/checkpoint.h5 every checkpoint.interval of simulated time (case) or every
  * sim_set_checkpoint_wall() seconds of wall time, whichever comes first, and calls progress with
  * checkpoint = 1 after each. A sim loaded from a checkpoint (checkpoint_load) continues from its
  * step and continues out_dir/result.h5 when it exists (run.c says how). */
+#define SIM_STOP_CHECKPOINT 2
 enum poro_status sim_run(struct sim *s, const char *out_dir, const char *solver_version,
 			 sim_progress_fn progress, void *user, volatile int *stop);
 

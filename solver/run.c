@@ -211,7 +211,10 @@ enum poro_status sim_run(struct sim *s, const char *out_dir, const char *solver_
 		st = sample_probes(s, o, values);
 	while (!st && !sim_done(s)) {
 		if (stop && *stop) {
-			st = poro_error_set(&s->err, PORO_EINTERRUPTED, "interrupted at step %ld (t = %.6g s)",
+			if (*stop == SIM_STOP_CHECKPOINT && s->step > step0)
+				st = checkpoint(s, o, out_dir, progress, user, t0, step0);
+			if (!st)
+				st = poro_error_set(&s->err, PORO_EINTERRUPTED, "interrupted at step %ld (t = %.6g s)",
 					    s->step, s->time);
 			break;
 		}

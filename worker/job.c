@@ -53,7 +53,7 @@
 #define JOB_FRAMES_INDEX "frames.json"   /* their index, uploaded after frames.bin */
 #define JOB_TEXT_MAX 8192   /* bytes of a message about the files, as the server's MESSAGE_MAX */
 
-enum stop_reason { STOP_NONE, STOP_CANCEL, STOP_WALL, STOP_SHUTDOWN, STOP_LOST };
+enum stop_reason { STOP_NONE, STOP_CANCEL, STOP_WALL, STOP_SHUTDOWN, STOP_LOST, STOP_RETIRE };
 enum send_result { SEND_OK, SEND_RETRY, SEND_REFUSED, SEND_LOST };
 
 /* A result file staged for upload: a snapshot path and its checksum. */
@@ -337,6 +337,24 @@ static void heartbeat_if_due(struct job *j, double now)
 	}
 }
 
+/* The worker's allocation ends soon (worker_retire_due): the solver is asked for a checkpoint of
+ * its current step and to stop (SIGUSR1), so the job goes back to the queue as an infrastructure
+ * failure and another worker resumes it from that checkpoint. A solver still running at half the
+ * margin is stopped without one (the last periodic checkpoint stands). */
+static void retire_if_due(struct job *j, double now)
+{
+	if (!j->running || !worker_retire_due(now, 1.0))
+		return;
+	if (j->stop == STOP_NONE) {
+		worker_say("%s: the allocation ends in %.0f s: checkpointing the job and handing it back", j->tag,
+			   worker_opt.end_at - now);
+		j->stop = STOP_RETIRE;
+		child_signal(j->pid, SIGUSR1);
+	} else if (j->stop == STOP_RETIRE && worker_retire_due(now, 0.5)) {
+		terminate(j, now);
+	}
+}
+
 /* Runs until the solver is reaped and its output drained, or the lease is lost. */
 static void supervise(struct job *j)
 {
@@ -349,6 +367,7 @@ static void supervise(struct job *j)
 			j->stop = STOP_SHUTDOWN;
 			terminate(j, now);
 		}
+		retire_if_due(j, now);
 		if (j->running && j->wall_time > 0 && now - j->started >= (double)j->wall_time && j->stop == STOP_NONE) {
 			worker_say("%s: wall time of %ld s reached, terminating the solver", j->tag, j->wall_time);
 			j->stop = STOP_WALL;
@@ -403,6 +422,10 @@ static const char *outcome(struct job *j, char *message, size_t size, int *exit_
 		return "failed";
 	case STOP_SHUTDOWN:
 		snprintf(message, size, "worker '%s' was stopped while the job ran", worker_opt.name);
+		return "infrastructure";
+	case STOP_RETIRE:
+		snprintf(message, size, "handed back with a checkpoint: the allocation of worker '%s' was about to end",
+			 worker_opt.name);
 		return "infrastructure";
 	default:
 		break;

@@ -3,7 +3,8 @@
  * repeat until the worker drains. Each slot has two clients: the claim client aborts its long-poll
  * at once when the worker drains; the job client never aborts, so a draining worker still delivers
  * its running jobs' logs, files and outcomes. A claim that fails for want of a server is retried
- * with backoff; a refused token ends the worker.
+ * with backoff; a refused token, or a server whose TLS certificate cannot be verified, ends the
+ * worker.
  *
  * Exclusive jobs (docs/benchmarks.md "Exclusive jobs": the jobs that time the solver) run alone
  * on the worker. The slots share three facts under one lock: how many jobs run, whether an
@@ -96,10 +97,41 @@ static void claim_end(int claimer, int got_exclusive)
 	pthread_mutex_unlock(&turn_lock);
 }
 
-static json_t *claim_body(int exclusive_ok)
+/* The claim: "exclusive" when it may be answered with an exclusive job; with a lifetime it says
+ * how many seconds a job may still run here (the server gives only jobs whose wall_time_seconds
+ * fit), and with --idle-exit it waits no longer than the idle time left. */
+static json_t *claim_body(double now, double idle_since, int exclusive_ok)
 {
-	return json_pack("{s:s, s:s, s:i, s:i, s:b}", "worker", worker_opt.name, "host", worker_opt.host, "threads",
-			 worker_opt.threads, "wait_seconds", WORKER_CLAIM_WAIT, "exclusive", exclusive_ok);
+	int wait = WORKER_CLAIM_WAIT;
+	if (worker_opt.idle_exit > 0) {
+		double left = idle_since + (double)worker_opt.idle_exit - now;
+		wait = left < wait ? (left > 1 ? (int)left : 1) : wait;
+	}
+	long left = worker_seconds_left(now);
+	if (left >= 0 && left < wait)   /* a job handed in now would be handed back at once */
+		wait = left > 1 ? (int)left : 1;
+	json_t *body = json_pack("{s:s, s:s, s:i, s:i, s:b}", "worker", worker_opt.name, "host", worker_opt.host,
+				 "threads", worker_opt.threads, "wait_seconds", wait, "exclusive", exclusive_ok);
+	if (body && left >= 0) {
+		/* a pilot's allocation is fixed: it takes only what fits in its time and cores */
+		json_object_set_new(body, "seconds_left", json_integer(left));
+		json_object_set_new(body, "max_threads", json_integer(worker_opt.threads));
+	}
+	return body;
+}
+
+/* 1 when the slot should claim no more: the allocation is about to end, or it idled too long. */
+static int slot_retires(int slot, double now, double idle_since)
+{
+	if (worker_retire_due(now, 1.0)) {
+		worker_say("slot %d: the allocation ends in %.0f s: claiming no more", slot, worker_opt.end_at - now);
+		return 1;
+	}
+	if (worker_opt.idle_exit > 0 && now - idle_since >= (double)worker_opt.idle_exit) {
+		worker_say("slot %d: no job for %ld s: ending (--idle-exit)", slot, worker_opt.idle_exit);
+		return 1;
+	}
+	return 0;
 }
 
 void *slot_main(void *arg)
@@ -115,7 +147,8 @@ void *slot_main(void *arg)
 		http_client_set_abort(claimer, &worker_draining);
 	}
 	struct backoff b = {0};
-	while (!atomic_load(&worker_draining)) {
+	double idle_since = worker_now();
+	while (!atomic_load(&worker_draining) && !slot_retires(slot, worker_now(), idle_since)) {
 		struct http_response r;
 		char why[700];
 		int may_exclusive = claim_begin();
@@ -123,7 +156,7 @@ void *slot_main(void *arg)
 			claim_end(may_exclusive, 0);
 			break;
 		}
-		json_t *body = claim_body(may_exclusive);
+		json_t *body = claim_body(worker_now(), idle_since, may_exclusive);
 		long status = http_json(claimer, "POST", "/v1/worker/claim", body, NULL, WORKER_CLAIM_WAIT + 30, &r);
 		json_decref(body);
 		const json_t *job = status == 200 ? json_object_get(r.json, "job") : NULL;
@@ -139,10 +172,13 @@ void *slot_main(void *arg)
 				slot_finished(exclusive);
 			else if (exclusive)
 				exclusive_abandoned();
+			idle_since = worker_now();
 		} else if (status == 204) {
 			backoff_reset(&b);
-		} else if (status == 401 || status == 403) {
-			worker_say("claim refused, stopping: %s", http_describe(&r, why, sizeof why));
+		} else if (status == 401 || status == 403 || r.tls_unverified) {
+			/* a refused token or an unverifiable server stays so: retrying would only hide it */
+			worker_say("%s, stopping: %s", r.tls_unverified ? "server not trusted" : "claim refused",
+				   http_describe(&r, why, sizeof why));
 			atomic_store(&worker_fatal, 1);
 			atomic_store(&worker_draining, 1);
 		} else {
