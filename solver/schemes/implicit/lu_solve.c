@@ -78,7 +78,6 @@ enum poro_status lu_solver_factorise(struct lu_solver *s, const double *values, 
 	s->values = values;
 	s->factorisations++;
 	s->factor_nonzeros = (long)(s->info[UMFPACK_LNZ] + s->info[UMFPACK_UNZ]);
-	if (getenv("LU_DEBUG")) fprintf(stderr, "n %ld nnz %ld LU nnz %ld flops %.3g numeric time %.3g strategy %g ordering %g\n", (long)s->n, (long)s->colptr[s->n], s->factor_nonzeros, s->info[UMFPACK_FLOPS], s->info[UMFPACK_NUMERIC_WALLTIME], s->info[UMFPACK_STRATEGY_USED], s->info[UMFPACK_ORDERING_USED]);
 	return PORO_OK;
 }
 
