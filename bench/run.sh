@@ -1,11 +1,13 @@
 #!/usr/bin/env bash
-# Speed figures for PoroMPM, printed and never asserted. One thread unless OMP_NUM_THREADS is set.
+# Speed figures for PoroMPM, printed and never asserted. One thread unless OMP_NUM_THREADS is set,
+# except solver_bench, which steps one simulation per thread count (1 and 2) in turn and prints
+# them side by side with the speed-up.
 set -u
 build=${1:-build}
 cd "$(dirname "$0")/.."
 export OMP_NUM_THREADS=${OMP_NUM_THREADS:-1}
 echo "machine: $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | sed 's/^ *//'), $(nproc --all) cores; OMP_NUM_THREADS=$OMP_NUM_THREADS"
-echo "== solver: 2-D elastic block, >= 100,000 soil points"
+echo "== solver: 2-D elastic block, >= 100,000 soil points, 1 and 2 threads in turn"
 "$build"/bench/solver_bench
 "$build"/bench/solver_bench --single-point
 "$build"/bench/solver_bench --projection consistent

@@ -6,11 +6,20 @@
  * 0.1 m cell on a 25 m x 10 m block). After WARMUP steps it times STEPS steps and prints, per
  * material-point step (soil plus water points), the total and each phase of the step: the
  * particle phases and the pressure assembly and factor-and-solve separately. Figures are
- * printed, never asserted; bench/run.sh runs it on one thread.
+ * printed, never asserted.
+ *
+ * Thread counts are compared side by side in one run: one simulation per count in --threads,
+ * stepped in turn (a step on one thread, then a step on two, ...), so that every count sees the
+ * same machine. This machine is shared and its speed drifts by 10-40% within an hour
+ * (docs/performance.md), which makes absolute times of separate runs useless as a comparison;
+ * the ratio of counts stepped in turn is what the figures mean. The runs are also compared point
+ * for point after the last step: a step's result must not depend on the thread count
+ * (tests/solver/thread_count_test.c), and the bench says whether that held here.
  *
  *   solver_bench [--cells-x N] [--cells-y N] [--ppc N] [--steps N] [--single-point]
- *                [--projection laplacian|consistent]
+ *                [--projection laplacian|consistent] [--threads N[,N...]]   (default 1,2)
  */
+#include <omp.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -19,6 +28,7 @@
 #include "poro.h"
 
 #define WARMUP 3
+#define COUNTS_MAX 4   /* thread counts compared in one run */
 
 static char *make_case(int cells_x, int cells_y, int ppc, const char *phases, const char *projection)
 {
@@ -41,9 +51,41 @@ static char *make_case(int cells_x, int cells_y, int ppc, const char *phases, co
 	return json;
 }
 
+/* 1 if the two runs' points agree bit for bit (positions, velocities, pore pressures). */
+static int same_points(const struct sim *a, const struct sim *b)
+{
+	const struct particles *sets[2][2] = {{sim_soil(a), sim_water(a)}, {sim_soil(b), sim_water(b)}};
+	for (int k = 0; k < 2; k++) {
+		const struct particles *p = sets[0][k], *q = sets[1][k];
+		if (p->n != q->n || memcmp(p->x, q->x, 2 * sizeof(double) * (size_t)p->n) ||
+		    memcmp(p->v, q->v, 2 * sizeof(double) * (size_t)p->n) ||
+		    memcmp(p->pressure, q->pressure, sizeof(double) * (size_t)p->n))
+			return 0;
+	}
+	return 1;
+}
+
+/* Parses "1,2" into counts; returns how many, 0 if malformed. */
+static int parse_threads(const char *list, int *counts)
+{
+	int n = 0;
+	for (const char *c = list; *c && n < COUNTS_MAX;) {
+		char *end;
+		long t = strtol(c, &end, 10);
+		if (end == c || t < 1 || t > 256)
+			return 0;
+		counts[n++] = (int)t;
+		c = *end == ',' ? end + 1 : end;
+		if (*end && *end != ',')
+			return 0;
+	}
+	return n;
+}
+
 int main(int argc, char **argv)
 {
 	int cells_x = 250, cells_y = 100, ppc = 2, steps = 20;
+	int counts[COUNTS_MAX] = {1, 2}, runs = 2;
 	const char *phases = "double_point", *projection = "laplacian";
 	for (int i = 1; i < argc; i++) {
 		if (!strcmp(argv[i], "--cells-x") && i + 1 < argc) cells_x = atoi(argv[++i]);
@@ -52,45 +94,72 @@ int main(int argc, char **argv)
 		else if (!strcmp(argv[i], "--steps") && i + 1 < argc) steps = atoi(argv[++i]);
 		else if (!strcmp(argv[i], "--single-point")) phases = "single_point";
 		else if (!strcmp(argv[i], "--projection") && i + 1 < argc) projection = argv[++i];
+		else if (!strcmp(argv[i], "--threads") && i + 1 < argc && (runs = parse_threads(argv[++i], counts))) ;
 		else {
-			fprintf(stderr, "solver_bench: unknown argument '%s'\n", argv[i]);
+			fprintf(stderr, "solver_bench: unknown or malformed argument '%s'\n", argv[i]);
 			return 2;
 		}
 	}
 	char *json = make_case(cells_x, cells_y, ppc, phases, projection);
 	struct case_spec *c = NULL;
-	struct sim *s = NULL;
+	struct sim *s[COUNTS_MAX] = {NULL};
 	struct poro_error err = {0};
-	if (case_load_string(json, &c, &err) || sim_create(&s, c, &err)) {
+	if (case_load_string(json, &c, &err)) {
 		fprintf(stderr, "solver_bench: %s\n", err.message);
 		return 2;
 	}
-	long points = (long)sim_soil(s)->n + (sim_is_double_point(s) ? (long)sim_water(s)->n : 0);
-	for (int k = 0; k < WARMUP; k++)
-		if (sim_step(s))
-			break;
-	double before[PHASE_COUNT];
-	for (int ph = 0; ph < PHASE_COUNT; ph++)
-		before[ph] = sim_phase_seconds(s, ph);
-	for (int k = 0; k < steps; k++)
-		if (sim_step(s)) {
-			fprintf(stderr, "solver_bench: %s\n", sim_error(s)->message);
-			return 3;
+	for (int r = 0; r < runs; r++)
+		if (sim_create(&s[r], c, &err)) {
+			fprintf(stderr, "solver_bench: %s\n", err.message);
+			return 2;
 		}
-	double total = 0, pressure = 0;
-	printf("%s, %s projection: %ld soil + %ld water points, %d x %d cells, %d steps timed\n", phases, projection,
-	       (long)sim_soil(s)->n, sim_is_double_point(s) ? (long)sim_water(s)->n : 0L, cells_x, cells_y, steps);
-	for (int ph = 0; ph < PHASE_COUNT; ph++) {
-		double sec = sim_phase_seconds(s, ph) - before[ph];
-		double us = 1e6 * sec / ((double)steps * points);
-		total += us;
-		if (ph == PHASE_PRESSURE_ASSEMBLY || ph == PHASE_PRESSURE_SOLVE)
-			pressure += us;
-		printf("  %-24s %8.4f us per material-point step\n", sim_phase_name(ph), us);
+	long points = (long)sim_soil(s[0])->n + (sim_is_double_point(s[0]) ? (long)sim_water(s[0])->n : 0);
+	double before[COUNTS_MAX][PHASE_COUNT];
+	for (int k = 0; k < WARMUP + steps; k++)
+		for (int r = 0; r < runs; r++) {
+			if (k == WARMUP)
+				for (int ph = 0; ph < PHASE_COUNT; ph++)
+					before[r][ph] = sim_phase_seconds(s[r], ph);
+			omp_set_num_threads(counts[r]);
+			if (sim_step(s[r])) {
+				fprintf(stderr, "solver_bench: %s\n", sim_error(s[r])->message);
+				return 3;
+			}
+		}
+	const char *policy = getenv("OMP_WAIT_POLICY");
+	printf("%s, %s projection: %ld soil + %ld water points, %d x %d cells, %d steps timed, the thread counts "
+	       "stepped in turn (OMP_WAIT_POLICY=%s)\n", phases, projection, (long)sim_soil(s[0])->n,
+	       sim_is_double_point(s[0]) ? (long)sim_water(s[0])->n : 0L, cells_x, cells_y, steps,
+	       policy ? policy : "unset");
+	printf("  us per material-point step");
+	for (int r = 0; r < runs; r++)
+		printf("  %2d thread%s", counts[r], counts[r] > 1 ? "s" : " ");
+	for (int r = 1; r < runs; r++)
+		printf("  speed-up %d", counts[r]);
+	printf("\n");
+	double us[COUNTS_MAX][PHASE_COUNT + 3] = {{0}};   /* the phases, total, particle and grid, pressure */
+	for (int r = 0; r < runs; r++)
+		for (int ph = 0; ph < PHASE_COUNT; ph++) {
+			const double v = 1e6 * (sim_phase_seconds(s[r], ph) - before[r][ph]) / ((double)steps * points);
+			us[r][ph] = v;
+			us[r][PHASE_COUNT] += v;
+			us[r][ph == PHASE_PRESSURE_ASSEMBLY || ph == PHASE_PRESSURE_SOLVE ? PHASE_COUNT + 2 : PHASE_COUNT + 1] += v;
+		}
+	for (int row = 0; row < PHASE_COUNT + 3; row++) {
+		const char *name = row < PHASE_COUNT ? sim_phase_name(row) : row == PHASE_COUNT ? "TOTAL" :
+				   row == PHASE_COUNT + 1 ? "particle and grid phases" : "pressure assembly+solve";
+		printf("  %-26s", name);
+		for (int r = 0; r < runs; r++)
+			printf("  %9.4f", us[r][row]);
+		for (int r = 1; r < runs; r++)
+			printf("  %10.2f", us[r][row] > 0.0 ? us[0][row] / us[r][row] : 0.0);
+		printf("\n");
 	}
-	printf("  %-24s %8.4f us  (particle and grid phases %.4f, pressure solve %.4f)\n", "TOTAL", total,
-	       total - pressure, pressure);
-	sim_destroy(&s);
+	for (int r = 1; r < runs; r++)
+		printf("  points after the last step on %d and %d threads: %s\n", counts[0], counts[r],
+		       same_points(s[0], s[r]) ? "bit-identical" : "DIFFERENT");
+	for (int r = 0; r < runs; r++)
+		sim_destroy(&s[r]);
 	case_destroy(&c);
 	free(json);
 	return 0;
