@@ -4,6 +4,8 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "point_blocks.h"
+
 /* Every owned array, with its per-point width, in one table so init and release cannot drift. */
 #define PARTICLE_ARRAYS(X, skel)                                   \
 	X(x, 2, !alias) X(x0, 2, !alias) X(v, 2, 1) X(mass, 1, 1)  \
@@ -74,6 +76,11 @@ enum poro_status particles_add_affine(struct particles *p, struct poro_error *er
 	return PORO_OK;
 }
 
+enum poro_status particles_add_blocks(struct particles *p, const struct grid *g, struct poro_error *err)
+{
+	return p->blocks ? PORO_OK : point_blocks_create(&p->blocks, g, p->n, err);
+}
+
 void particles_remove(struct particles *p, idx_t q)
 {
 	idx_t last = p->n - 1;
@@ -86,6 +93,8 @@ void particles_remove(struct particles *p, idx_t q)
 		p->node0[q] = p->node0[last];
 	}
 	p->n--;
+	if (p->blocks)
+		p->blocks->n = -1;
 }
 
 void particles_release(struct particles *p)
@@ -100,5 +109,6 @@ void particles_release(struct particles *p)
 	free(p->v); free(p->C); free(p->mass); free(p->pressure);
 	free(p->stress); free(p->F); free(p->Be); free(p->state); free(p->plastic_strain);
 	free(p->dF); free(p->surface); free(p->surface_load);
+	point_blocks_destroy(&p->blocks);
 	memset(p, 0, sizeof *p);
 }
