@@ -16,18 +16,23 @@ void deformation_increment(struct sim *s, const double *du)
 	if (s->spec->formulation.position_update == POSITION_UPDATE_MUSL_DISPLACEMENT) {
 		/* 7b from the field whose gradient is dF, so volume and motion stay one (phases.h) */
 		g2p_vector(&s->grid, p, du, s->soil_grad);
+		#pragma omp parallel for schedule(static)
 		for (idx_t k = 0; k < DIM * p->n; k++)
 			p->x[k] += s->soil_grad[k];
 	}
+	#pragma omp parallel for schedule(static)
 	for (idx_t q = 0; q < p->n; q++) {
 		p->dF[4 * q] += 1.0, p->dF[4 * q + 3] += 1.0;
 	}
 }
 
+/* Every point is updated, in parallel; the failure reported is the lowest-numbered failing
+ * point's, as a serial loop stopping at the first would report it, at any thread count. */
 enum poro_status deformation_apply(struct sim *s)
 {
 	struct particles *p = &s->soil;
-	idx_t bad = -1;
+	idx_t bad = p->n;
+	#pragma omp parallel for schedule(static) reduction(min : bad)
 	for (idx_t q = 0; q < p->n; q++) {
 		double *dF = p->dF + 4 * q, *F = p->F + 4 * q;
 		double dJ = dF[0] * dF[3] - dF[1] * dF[2];
@@ -38,15 +43,15 @@ enum poro_status deformation_apply(struct sim *s)
 		double J = p->volume[q] / p->volume0[q];
 		double n = 1.0 - (1.0 - p->porosity0[q]) / J;
 		if (!(dJ > 0.0) || !(n > 0.0 && n < 1.0)) {
-			bad = q;
-			break;
+			bad = q < bad ? q : bad;
+			continue;
 		}
 		p->porosity[q] = n;
 		const struct case_body *body = &s->spec->bodies[p->body[q]];
 		p->conductivity[q] = permeability_conductivity(body->permeability_law, body->hydraulic_conductivity,
 							       p->porosity0[q], n, J);   /* (8g) */
 	}
-	if (bad >= 0)
+	if (bad < p->n)
 		return poro_error_set(&s->err, PORO_ESOLVER, "soil point %ld at (%.6g, %.6g) m: volume ratio %.6g "
 				      "gives porosity outside (0, 1) or an inverted point at step %ld (J must stay "
 				      "above 1 - n0 = %.6g, where the pores close)",
