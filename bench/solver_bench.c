@@ -16,6 +16,10 @@
  * for point after the last step: a step's result must not depend on the thread count
  * (tests/solver/thread_count_test.c), and the bench says whether that held here.
  *
+ * The binning of the points into the scatters' blocks (point_blocks.h), part of the shape
+ * functions phase, is timed apart on one thread: BINNING_REPEATS sorts of each set, per
+ * material-point step.
+ *
  *   solver_bench [--cells-x N] [--cells-y N] [--ppc N] [--steps N] [--single-point]
  *                [--projection laplacian|consistent] [--threads N[,N...]]   (default 1,2)
  */
@@ -25,10 +29,13 @@
 #include <string.h>
 
 #include "case.h"
+#include "point_blocks.h"
 #include "poro.h"
+#include "sim_internal.h"
 
 #define WARMUP 3
 #define COUNTS_MAX 4   /* thread counts compared in one run */
+#define BINNING_REPEATS 20
 
 static char *make_case(int cells_x, int cells_y, int ppc, const char *phases, const char *projection)
 {
@@ -63,6 +70,22 @@ static int same_points(const struct sim *a, const struct sim *b)
 			return 0;
 	}
 	return 1;
+}
+
+/* Microseconds per material-point step of sorting s's point sets into their blocks, one thread. */
+static double binning_us(struct sim *s, long points)
+{
+	struct particles *sets[2] = {&s->soil, s->double_point ? &s->water : NULL};
+	const int threads = omp_get_max_threads();
+	omp_set_num_threads(1);
+	const double t0 = sim_clock();
+	for (int k = 0; k < BINNING_REPEATS; k++)
+		for (int i = 0; i < 2; i++)
+			if (sets[i] && sets[i]->blocks)
+				point_blocks_sort(sets[i]->blocks, sets[i]);
+	const double us = 1e6 * (sim_clock() - t0) / ((double)BINNING_REPEATS * points);
+	omp_set_num_threads(threads);
+	return us;
 }
 
 /* Parses "1,2" into counts; returns how many, 0 if malformed. */
@@ -155,6 +178,8 @@ int main(int argc, char **argv)
 			printf("  %10.2f", us[r][row] > 0.0 ? us[0][row] / us[r][row] : 0.0);
 		printf("\n");
 	}
+	printf("  binning into blocks (in the shape functions, one thread): %.4f us per material-point step\n",
+	       binning_us(s[0], points));
 	for (int r = 1; r < runs; r++)
 		printf("  points after the last step on %d and %d threads: %s\n", counts[0], counts[r],
 		       same_points(s[0], s[r]) ? "bit-identical" : "DIFFERENT");

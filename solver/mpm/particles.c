@@ -78,7 +78,8 @@ enum poro_status particles_add_affine(struct particles *p, struct poro_error *er
 
 enum poro_status particles_add_blocks(struct particles *p, const struct grid *g, struct poro_error *err)
 {
-	return p->blocks ? PORO_OK : point_blocks_create(&p->blocks, g, p->n, err);
+	static const idx_t size[2] = {POINT_BLOCK_CELLS_X, POINT_BLOCK_CELLS_Y};
+	return p->blocks ? PORO_OK : point_blocks_create(&p->blocks, g, p->n, size, err);
 }
 
 void particles_remove(struct particles *p, idx_t q)

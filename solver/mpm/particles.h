@@ -96,8 +96,9 @@ enum poro_status particles_init_alias(struct particles *w, const struct particle
 /* Gives p an affine velocity array C, zeroed (APIC, transfer.h). Returns PORO_ENOMEM on failure. */
 enum poro_status particles_add_affine(struct particles *p, struct poro_error *err);
 
-/* Gives p the scatter blocks of grid g for its n points (point_blocks.h); shape_evaluate sorts
- * them from then on. Returns PORO_ENOMEM on failure. */
+/* Gives p the scatter blocks of grid g for its n points, POINT_BLOCK_CELLS_X x POINT_BLOCK_CELLS_Y
+ * cells each (point_blocks.h); shape_evaluate sorts them from then on. Returns PORO_ENOMEM on
+ * failure. */
 struct grid;
 enum poro_status particles_add_blocks(struct particles *p, const struct grid *g, struct poro_error *err);
 

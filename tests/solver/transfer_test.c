@@ -452,7 +452,7 @@ static void scatter_brute_force(const struct grid *g, enum case_shape kind, cons
 	}
 }
 
-/* A random cloud on a grid of 5 x 4 blocks (point_blocks.h), a third of it within 1.3 cells of
+/* A random cloud on a grid of 3 x 5 blocks (point_blocks.h), a third of it within 1.3 cells of
  * an edge and every 97th point on an edge or a corner, through every scatter with blocks: on one
  * thread and on two the same bits, and each output within PARALLEL_TOLERANCE of its largest
  * entry of the brute-force sums (the linear fit: of the same kernel without blocks, which runs
@@ -460,7 +460,7 @@ static void scatter_brute_force(const struct grid *g, enum case_shape kind, cons
 static void check_parallel_scatters(enum case_shape kind, const char *label)
 {
 	const double h = 0.0473;
-	struct case_grid spec = {.origin = {-1.917, 0.661}, .extent = {37 * h, 29 * h}, .cell_size = h};
+	struct case_grid spec = {.origin = {-1.917, 0.661}, .extent = {150 * h, 29 * h}, .cell_size = h};
 	struct grid g;
 	struct particles p;
 	struct cloud c;
