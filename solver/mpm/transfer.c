@@ -8,8 +8,6 @@
  * this design and what it costs; docs/performance.md, "Parallel scatters", the figures). The
  * loops' bodies are those of the serial kernels: only the order of the points changed.
  */
-#include <string.h>
-
 #include "transfer.h"
 
 void p2g_scalar(const struct grid *g, const struct particles *p, const double *weight,
@@ -176,7 +174,7 @@ void p2g_scalar_linear_fit(const struct grid *g, const struct particles *p, cons
 	const idx_t nx = g->nodes[0];
 	enum { W, WX, WY, WXX, WXY, WYY, WV, WVX, WVY, MOMENTS };   /* sums of w, w dx, ..., w v dy */
 	double *m = moments;
-	memset(m, 0, sizeof(double) * MOMENTS * (size_t)g->node_count);
+	grid_zero(m, MOMENTS * (size_t)g->node_count);
 	FOR_POINTS_BY_BLOCK(p, q, {
 		const struct shape_factors f = particle_shape(p, q);
 		double dX[SHAPE_SUPPORT_MAX], dY[SHAPE_SUPPORT_MAX];   /* X_a - x_p: minus x_p - x_I */

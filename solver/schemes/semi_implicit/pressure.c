@@ -189,8 +189,8 @@ void pressure_gradient_operators(struct sim *s)
 	struct semi_implicit *si = semi_implicit_of(s);
 	struct pressure_system *ps = &si->ps;
 	const size_t gst = (size_t)ps->g_width * ps->g_width * 2, nodes = (size_t)s->grid.node_count;
-	memset(ps->grad_s, 0, sizeof(double) * nodes * gst);
-	memset(ps->grad_w, 0, sizeof(double) * nodes * gst);
+	grid_zero(ps->grad_s, nodes * gst);
+	grid_zero(ps->grad_w, nodes * gst);
 	add_gradient_operator(s, &s->soil, ps->grad_s);
 	add_gradient_operator(s, &s->water, ps->grad_w);
 	if (s->spec->formulation.free_surface == FREE_SURFACE_WEAK) {   /* free_surface.c */
@@ -442,7 +442,7 @@ enum poro_status pressure_solve(struct sim *s)
 	struct pressure_system *ps = &si->ps;
 	const struct particles *p = &s->soil, *w = &s->water;
 	double t0 = sim_clock();
-	memset(ps->stencil, 0, sizeof(double) * (size_t)s->grid.node_count * ps->width * ps->width);
+	grid_zero(ps->stencil, (size_t)s->grid.node_count * ps->width * ps->width);
 	double diagonal_mean = 0.0;
 	if (ps->exact) {
 		memset(si->rhs, 0, sizeof(double) * (size_t)s->grid.node_count);

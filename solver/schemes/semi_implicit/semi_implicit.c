@@ -104,7 +104,7 @@ static void reset_grid(struct sim *s)
 	struct semi_implicit *si = semi_implicit_of(s);
 	const size_t n = (size_t)s->grid.node_count;
 	grid_fields_reset(&s->f, &s->grid);
-#define ZERO(name, width, reset) if (reset) memset(si->name, 0, n * (width) * sizeof(double));
+#define ZERO(name, width, reset) if (reset) grid_zero(si->name, n * (width));
 	SEMI_IMPLICIT_NODAL_FIELDS(ZERO)
 #undef ZERO
 }
