@@ -1,11 +1,16 @@
 # PoroMPM - one boring Makefile.
-#   make run     install what is missing, build, run the Terzaghi example and report its error
+#   make run     install what is missing, build what it runs, run the Terzaghi example and report
+#                its error
 #   make test    unit tests, reduced-size verification, bad-input tests; ends "N passed, N failed"
 #   make verify  paper-size verification runs (long)
 #   make bench   speed figures (printed, never asserted)
 #   make test SAN=1   the same tests under AddressSanitizer + UBSan
 #   make test-san     the service's tests alone under AddressSanitizer + UBSan (docs/service.md §6)
+#   make install [PREFIX=/usr/local] [DESTDIR=]   programs, systemd units, man pages, completions
+#   make uninstall    removes what make install put there
 # Every public target first runs deploy/deps.sh, which returns at once when nothing is missing.
+# They build with one job per core and print one short line per file ("  CC      build/x.o");
+# V=1 prints the whole commands instead.
 
 CC      ?= cc
 BUILD   ?= build$(if $(SAN),-san)
@@ -17,8 +22,16 @@ PKGS    = jansson hdf5
 CPPFLAGS = -D_POSIX_C_SOURCE=200809L -DPORO_VERSION=\"$(VERSION)\" $(addprefix -I,$(SOLVER_DIRS)) -I/usr/include/suitesparse $(shell pkg-config --cflags $(PKGS) 2>/dev/null)
 VERSION := $(shell git describe --always --dirty --tags 2>/dev/null || echo unknown)
 CFLAGS  = -std=c11 $(OPT) -g -fopenmp $(WARN) $(SANFLAGS)
-LDLIBS  = $(shell pkg-config --libs $(PKGS) 2>/dev/null) -lcholmod -lm
+LDLIBS  = $(shell pkg-config --libs $(PKGS) 2>/dev/null) -lumfpack -lcholmod -lm
 LDFLAGS = -fopenmp $(SANFLAGS)
+
+# One line per file unless V=1: $(call quiet,CC) before a command prints "  CC      TARGET" and
+# hides the command. The public targets run their build in a sub-make with one job per core,
+# unless the caller already gave -j (then its job server is used).
+V ?=
+quiet = $(if $(filter 1,$(V)),,@printf '  %-7s %s\n' '$(1)' '$@';)
+JOBS ?= $(shell nproc 2>/dev/null || echo 1)
+SUBMAKE_FLAGS = --no-print-directory $(if $(findstring jobserver,$(MAKEFLAGS)),,-j$(JOBS))
 
 # solver/ (README, "Layout"): the simulation object and its run loop at the top; case/ reads and
 # validates a case; material/ the constitutive models; mpm/ the grid, points, shape functions,
@@ -53,23 +66,32 @@ SERVER_LIBS = -lmicrohttpd -lsqlite3 -lm $(SVC_LIBS)
 SERVICE    = $(if $(SERVER_OBJ),$(BUILD)/poro-server) $(if $(WORKER_OBJ),$(BUILD)/poro-worker) \
 	     $(if $(CLIENT_OBJ),$(BUILD)/poro $(BUILD)/poro-load)
 
-.PHONY: all deps run test test-san verify bench clean build-all build-service format
+.PHONY: FORCE all deps run test test-san verify bench clean build-all build-run build-service format install \
+	install-files build-install uninstall
 .DEFAULT_GOAL := all
+# objects made on the way to a program are kept: deleting them would only rebuild them next time
+.PRECIOUS: $(BUILD)/%.o
 
 deps:
 	@bash deploy/deps.sh
 
 all: deps
-	@$(MAKE) --no-print-directory build-all
+	@$(MAKE) $(SUBMAKE_FLAGS) build-all
 
 build-all: $(POROSOLVE) $(TEST_BIN) $(COMMON_TEST_BIN) $(BENCH_BIN) $(TOOLS) $(SERVICE)
 
+# What tests/run_example.sh runs: the server, a worker, the poro CLI, the solver and the error
+# against Terzaghi's closed form; no test program.
+RUN_BIN = $(POROSOLVE) $(BUILD)/terzaghi-error $(BUILD)/poro-server $(BUILD)/poro-worker $(BUILD)/poro
+
+build-run: $(RUN_BIN)
+
 run: deps
-	@$(MAKE) --no-print-directory build-all
+	@$(MAKE) $(SUBMAKE_FLAGS) build-run
 	@bash tests/run_example.sh $(BUILD)
 
 test: deps
-	@$(MAKE) --no-print-directory build-all
+	@$(MAKE) $(SUBMAKE_FLAGS) build-all
 	@bash tests/run.sh $(BUILD) test
 
 # The service's binaries, poro-solve (the workers run it) and the tests of common/: what the
@@ -77,30 +99,40 @@ test: deps
 build-service: $(POROSOLVE) $(COMMON_TEST_BIN) $(SERVICE)
 
 test-san: deps
-	@$(MAKE) --no-print-directory SAN=1 build-service
+	@$(MAKE) $(SUBMAKE_FLAGS) SAN=1 build-service
 	@bash tests/run.sh build-san service
 
 verify: deps
-	@$(MAKE) --no-print-directory build-all
+	@$(MAKE) $(SUBMAKE_FLAGS) build-all
 	@bash tests/run.sh $(BUILD) verify
 
 bench: deps
-	@$(MAKE) --no-print-directory build-all
+	@$(MAKE) $(SUBMAKE_FLAGS) build-all
 	@bash bench/run.sh $(BUILD)
 
 $(BUILD)/%.o: %.c $(SOLVER_HDR) $(wildcard tests/*.h tests/verify/*.h common/*.h client/*.h server/*.h worker/*.h)
 	@mkdir -p $(dir $@)
-	$(CC) $(CPPFLAGS) -Icommon -Iclient $(CFLAGS) -c $< -o $@
+	$(call quiet,CC)$(CC) $(CPPFLAGS) -Icommon -Iclient $(CFLAGS) -c $< -o $@
+
+# The files that print the version (PORO_VERSION, from git describe) are compiled again when it
+# changes, as after a commit: $(BUILD)/version.stamp holds the version they were built with and is
+# rewritten only when it differs, so an unchanged version rebuilds nothing.
+VERSION_OBJ = $(patsubst %.c,$(BUILD)/%.o,$(shell grep -l PORO_VERSION $(SOLVER_SRC) cli/*.c server/*.c worker/*.c 2>/dev/null))
+$(VERSION_OBJ): $(BUILD)/version.stamp
+$(BUILD)/version.stamp: FORCE
+	@mkdir -p $(dir $@)
+	@[ "$$(cat $@ 2>/dev/null)" = "$(VERSION)" ] || echo "$(VERSION)" > $@
+FORCE:
 
 $(LIBPORO): $(SOLVER_OBJ)
 	@rm -f $@
-	ar rcs $@ $^
+	$(call quiet,AR)ar rcs $@ $^
 
 $(POROSOLVE): $(BUILD)/cli/poro_solve.o $(LIBPORO)
-	$(CC) $(LDFLAGS) $^ $(LDLIBS) -o $@
+	$(call quiet,LD)$(CC) $(LDFLAGS) $^ $(LDLIBS) -o $@
 
 $(BUILD)/terzaghi-error: $(BUILD)/tools/terzaghi_error.o $(LIBPORO)
-	$(CC) $(LDFLAGS) $^ $(LDLIBS) -o $@
+	$(call quiet,LD)$(CC) $(LDFLAGS) $^ $(LDLIBS) -o $@
 
 $(BUILD)/tools/terzaghi_error.o: tests/verify/analytic.h
 
@@ -108,28 +140,85 @@ $(BUILD)/tools/terzaghi_error.o: tests/verify/analytic.h
 # it calls for the run-out picture.
 $(BUILD)/poro-plot: cli/poro_plot.py
 	@mkdir -p $(dir $@)
-	cp $< $@ && chmod +x $@
+	$(call quiet,GEN)cp $< $@ && chmod +x $@
 
 $(BUILD)/tests/%: $(BUILD)/tests/%.o $(LIBPORO)
-	$(CC) $(LDFLAGS) $^ $(LDLIBS) -o $@
+	$(call quiet,LD)$(CC) $(LDFLAGS) $^ $(LDLIBS) -o $@
 
 $(BUILD)/tests/common/%: $(BUILD)/tests/common/%.o $(COMMON_OBJ)
-	$(CC) $(LDFLAGS) $^ $(SVC_LIBS) -o $@
+	$(call quiet,LD)$(CC) $(LDFLAGS) $^ $(SVC_LIBS) -o $@
 
 $(BUILD)/bench/%: $(BUILD)/bench/%.o $(LIBPORO)
-	$(CC) $(LDFLAGS) $^ $(LDLIBS) -o $@
+	$(call quiet,LD)$(CC) $(LDFLAGS) $^ $(LDLIBS) -o $@
 
 $(BUILD)/poro-server: $(SERVER_OBJ) $(COMMON_OBJ) $(LIBPORO)
-	$(CC) $(LDFLAGS) $^ $(SERVER_LIBS) -o $@
+	$(call quiet,LD)$(CC) $(LDFLAGS) $^ $(SERVER_LIBS) -o $@
 
 $(BUILD)/poro-worker: $(WORKER_OBJ) $(CLIENT_OBJ) $(COMMON_OBJ)
-	$(CC) $(LDFLAGS) $^ -lcurl $(SVC_LIBS) -o $@
+	$(call quiet,LD)$(CC) $(LDFLAGS) $^ -lcurl $(SVC_LIBS) -o $@
 
-$(BUILD)/poro: $(BUILD)/cli/poro.o $(CLIENT_OBJ) $(COMMON_OBJ)
-	$(CC) $(LDFLAGS) $^ -lcurl $(SVC_LIBS) -lm -o $@
+# poro: cli/poro.c and its commands in cli/poro/
+PORO_CLI_OBJ = $(patsubst %.c,$(BUILD)/%.o,$(wildcard cli/poro/*.c))
+$(BUILD)/cli/poro.o $(PORO_CLI_OBJ): $(wildcard cli/poro/*.h)
+
+$(BUILD)/poro: $(BUILD)/cli/poro.o $(PORO_CLI_OBJ) $(CLIENT_OBJ) $(COMMON_OBJ)
+	$(call quiet,LD)$(CC) $(LDFLAGS) $^ -lcurl $(SVC_LIBS) -lm -o $@
 
 $(BUILD)/poro-load: $(BUILD)/bench/poro_load.o $(CLIENT_OBJ) $(COMMON_OBJ)
-	$(CC) $(LDFLAGS) $^ -lcurl $(SVC_LIBS) -lm -o $@
+	$(call quiet,LD)$(CC) $(LDFLAGS) $^ -lcurl $(SVC_LIBS) -lm -o $@
+
+# make install [PREFIX=/usr/local] [DESTDIR=]: the programs, the systemd units (their @bindir@
+# replaced), the account they run as (sysusers.d), the configuration (only when none is there:
+# an operator's is never overwritten), the schemas, the man pages (version set), the bash
+# completions of poro and poro-solve, and web/ when it exists. make uninstall removes them and
+# leaves the configuration. Paths: docs/service.md §9.
+PREFIX      ?= /usr/local
+BINDIR      ?= $(PREFIX)/bin
+DATADIR     ?= $(PREFIX)/share
+MANDIR      ?= $(DATADIR)/man
+UNITDIR     ?= $(PREFIX)/lib/systemd/system
+SYSUSERSDIR ?= $(PREFIX)/lib/sysusers.d
+COMPLETIONDIR ?= $(DATADIR)/bash-completion/completions
+SYSCONFDIR  ?= /etc
+INSTALL_BIN = poro-server poro-worker poro poro-solve poro-plot
+UNITS       = $(patsubst deploy/systemd/%.in,%,$(wildcard deploy/systemd/*.in))
+MAN_PAGES   = $(notdir $(wildcard docs/man/*.1))
+COMPLETIONS = poro poro-solve
+SCHEMAS     = $(notdir $(wildcard schemas/*))
+
+build-install: $(addprefix $(BUILD)/,$(INSTALL_BIN))
+
+install: deps
+	@$(MAKE) $(SUBMAKE_FLAGS) build-install
+	@$(MAKE) --no-print-directory install-files
+
+install-files:
+	install -d $(DESTDIR)$(BINDIR) $(DESTDIR)$(UNITDIR) $(DESTDIR)$(SYSUSERSDIR) $(DESTDIR)$(MANDIR)/man1 \
+		$(DESTDIR)$(COMPLETIONDIR) $(DESTDIR)$(DATADIR)/poro/schemas $(DESTDIR)$(DATADIR)/poro/examples \
+		$(DESTDIR)$(SYSCONFDIR)/poro
+	install -m 755 $(addprefix $(BUILD)/,$(INSTALL_BIN)) $(DESTDIR)$(BINDIR)/
+	for u in $(UNITS); do \
+		sed -e 's|@bindir@|$(BINDIR)|g' -e 's|/etc/poro/|$(SYSCONFDIR)/poro/|g' deploy/systemd/$$u.in > $(DESTDIR)$(UNITDIR)/$$u && \
+		chmod 644 $(DESTDIR)$(UNITDIR)/$$u || exit 1; done
+	install -m 644 deploy/sysusers.d/poro.conf $(DESTDIR)$(SYSUSERSDIR)/poro.conf
+	for m in $(MAN_PAGES); do \
+		sed 's|@VERSION@|$(VERSION)|g' docs/man/$$m > $(DESTDIR)$(MANDIR)/man1/$$m && \
+		chmod 644 $(DESTDIR)$(MANDIR)/man1/$$m || exit 1; done
+	install -m 644 $(addprefix deploy/bash-completion/,$(COMPLETIONS)) $(DESTDIR)$(COMPLETIONDIR)/
+	install -m 644 $(addprefix schemas/,$(SCHEMAS)) $(DESTDIR)$(DATADIR)/poro/schemas/
+	install -m 644 deploy/poro-server.conf.example $(DESTDIR)$(DATADIR)/poro/examples/poro-server.conf
+	install -m 644 deploy/worker.env.example $(DESTDIR)$(DATADIR)/poro/examples/worker.env
+	[ -e $(DESTDIR)$(SYSCONFDIR)/poro/poro-server.conf ] || \
+		install -m 644 deploy/poro-server.conf.example $(DESTDIR)$(SYSCONFDIR)/poro/poro-server.conf
+	if [ -d web ]; then install -d $(DESTDIR)$(DATADIR)/poro/web && cp -R web/. $(DESTDIR)$(DATADIR)/poro/web/; fi
+
+uninstall:
+	rm -f $(addprefix $(DESTDIR)$(BINDIR)/,$(INSTALL_BIN)) $(addprefix $(DESTDIR)$(UNITDIR)/,$(UNITS)) \
+		$(DESTDIR)$(SYSUSERSDIR)/poro.conf $(addprefix $(DESTDIR)$(MANDIR)/man1/,$(MAN_PAGES)) \
+		$(addprefix $(DESTDIR)$(COMPLETIONDIR)/,$(COMPLETIONS))
+	rm -rf $(DESTDIR)$(DATADIR)/poro
+	@[ ! -e $(DESTDIR)$(SYSCONFDIR)/poro/poro-server.conf ] || \
+		echo "uninstall: $(DESTDIR)$(SYSCONFDIR)/poro/poro-server.conf is left in place (configuration)"
 
 # Formats the lines changed since FORMAT_BASE (default HEAD: the uncommitted work) by .clang-format;
 # `make format FORMAT_BASE=origin/main` takes a whole branch. Needs Debian's clang-format.

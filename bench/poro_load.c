@@ -22,10 +22,12 @@
  *       latency for make bench).
  *
  * Failures are counted, never fatal: the tool keeps going when the server disappears. Latency
- * percentiles are over the requests that got an answer (nearest-rank).
+ * percentiles are over the requests that got an answer (nearest-rank). Options are parsed by
+ * getopt_long ("--count 10" or "--count=10", before or after the mode); --help, --version.
  */
 #define _GNU_SOURCE
 #include <errno.h>
+#include <getopt.h>
 #include <math.h>
 #include <pthread.h>
 #include <signal.h>
@@ -41,6 +43,13 @@
 
 /* Long-poll of a load claim, seconds: short, so an empty queue ends the run quickly. */
 #define LOAD_CLAIM_WAIT 1
+/* Limits of --clients and --count. */
+#define LOAD_CLIENTS_MAX 4096
+#define LOAD_COUNT_MAX 100000000
+
+#ifndef PORO_VERSION
+#define PORO_VERSION "unknown"
+#endif
 
 struct load {
 	const char *server, *token, *case_file, *key_prefix, *record_path, *path;
@@ -207,63 +216,137 @@ static double percentile(const double *v, size_t n, double q)
 	return v[k > 0 ? k - 1 : 0];
 }
 
-static int usage(void)
+static void usage(FILE *f)
 {
-	fprintf(stderr, "usage: poro-load submit --server URL --token T --case FILE --clients C --count N\n"
-			"                        [--key-prefix P] [--record FILE] [--retry-seconds S] [--pause-ms MS]\n"
-			"       poro-load claim --server URL --token WORKER_TOKEN --count N --clients C\n"
-			"       poro-load get --server URL --token T --path PATH --count N --clients C\n");
-	return 2;
+	fprintf(f, "usage: poro-load submit --server URL --token T --case FILE --clients C --count N\n"
+		   "                        [--key-prefix P] [--record FILE] [--retry-seconds S] [--pause-ms MS]\n"
+		   "       poro-load claim --server URL --token WORKER_TOKEN --count N --clients C\n"
+		   "       poro-load get --server URL --token T --path PATH --count N --clients C\n"
+		   "       poro-load --help | --version\n");
 }
 
+static int help(void)
+{
+	usage(stdout);
+	printf("\nA load generator for the job service (make bench, the crash tests):\n"
+	       "  submit   N POST /v1/jobs of the case from C clients, submission i with Idempotency-Key P-i\n"
+	       "  claim    N claims from C worker clients, each finished at once as failed\n"
+	       "  get      N GET PATH from C clients\n"
+	       "Prints what succeeded and failed, the rate, and latency percentiles; failures are counted,\n"
+	       "never fatal.\n"
+	       "  --server URL          the server's URL\n"
+	       "  --token T             the bearer token\n"
+	       "  --clients C           concurrent clients, each with its own keep-alive connection (>= 1)\n"
+	       "  --count N             requests in all (>= 1)\n"
+	       "  --case FILE           submit: the case file\n"
+	       "  --key-prefix P        submit: the idempotency keys' prefix (load)\n"
+	       "  --record FILE         submit: a line \"key status job_id\" per attempt\n"
+	       "  --retry-seconds S     submit: resend a submission without an answer or with a 5xx, for S s\n"
+	       "  --pause-ms MS         submit: each client's pause between its submissions\n"
+	       "  --path PATH           get: the path, e.g. /v1/jobs?state=queued\n"
+	       "Exit status: 0 (also when requests failed), 2 for a bad command line, 1 when it cannot start.\n");
+	return 0;
+}
+
+/* An option value as a number in [lo, hi]: 0, or -1 after naming the option. */
+static int number_arg(const char *option, const char *text, double lo, double hi, double *out)
+{
+	char *end;
+	errno = 0;
+	double v = strtod(text, &end);
+	if (errno || end == text || *end || !(v >= lo && v <= hi)) {
+		fprintf(stderr, "poro-load: --%s needs a number in %.15g..%.15g, got '%s'\n", option, lo, hi, text);
+		return -1;
+	}
+	*out = v;
+	return 0;
+}
+
+/* Parses the command line into l: 0; 1 after --help or --version; -1 after saying what is wrong. */
 static int parse_args(struct load *l, int argc, char **argv)
 {
-	if (argc < 2)
-		return -1;
-	if (!strcmp(argv[1], "claim"))
-		l->mode = LOAD_CLAIM;
-	else if (!strcmp(argv[1], "get"))
-		l->mode = LOAD_GET;
-	else if (strcmp(argv[1], "submit"))
-		return -1;
-	for (int i = 2; i + 1 < argc; i += 2) {
-		const char *a = argv[i], *v = argv[i + 1];
-		if (!strcmp(a, "--server"))
-			l->server = v;
-		else if (!strcmp(a, "--token"))
-			l->token = v;
-		else if (!strcmp(a, "--case"))
-			l->case_file = v;
-		else if (!strcmp(a, "--key-prefix"))
-			l->key_prefix = v;
-		else if (!strcmp(a, "--record"))
-			l->record_path = v;
-		else if (!strcmp(a, "--clients"))
-			l->clients = atoi(v);
-		else if (!strcmp(a, "--count"))
-			l->count = atol(v);
-		else if (!strcmp(a, "--retry-seconds"))
-			l->retry_seconds = atof(v);
-		else if (!strcmp(a, "--pause-ms"))
-			l->pause_ms = atol(v);
-		else if (!strcmp(a, "--path"))
-			l->path = v;
-		else
-			return -1;
+	enum { O_SERVER = 1, O_TOKEN, O_CASE, O_KEY_PREFIX, O_RECORD, O_CLIENTS, O_COUNT, O_RETRY, O_PAUSE, O_PATH };
+	static const struct option opts[] = {
+		{ "server", required_argument, NULL, O_SERVER },   { "token", required_argument, NULL, O_TOKEN },
+		{ "case", required_argument, NULL, O_CASE },       { "key-prefix", required_argument, NULL, O_KEY_PREFIX },
+		{ "record", required_argument, NULL, O_RECORD },   { "clients", required_argument, NULL, O_CLIENTS },
+		{ "count", required_argument, NULL, O_COUNT },     { "retry-seconds", required_argument, NULL, O_RETRY },
+		{ "pause-ms", required_argument, NULL, O_PAUSE },  { "path", required_argument, NULL, O_PATH },
+		{ "help", no_argument, NULL, 'h' },                { "version", no_argument, NULL, 'V' },
+		{ NULL, 0, NULL, 0 }
+	};
+	int c, index = 0;
+	double v;
+	while ((c = getopt_long(argc, argv, "hV", opts, &index)) != -1) {
+		const char *name = opts[index].name;   /* of a long option: the numbers below are long only */
+		switch (c) {
+		case 'h':
+			help();
+			return 1;
+		case 'V':
+			printf("poro-load %s\n", PORO_VERSION);
+			return 1;
+		case O_SERVER: l->server = optarg; break;
+		case O_TOKEN: l->token = optarg; break;
+		case O_CASE: l->case_file = optarg; break;
+		case O_KEY_PREFIX: l->key_prefix = optarg; break;
+		case O_RECORD: l->record_path = optarg; break;
+		case O_PATH: l->path = optarg; break;
+		case O_CLIENTS:
+			if (number_arg(name, optarg, 1, LOAD_CLIENTS_MAX, &v))
+				return -1;
+			l->clients = (int)v;
+			break;
+		case O_COUNT:
+			if (number_arg(name, optarg, 1, LOAD_COUNT_MAX, &v))
+				return -1;
+			l->count = (long)v;
+			break;
+		case O_RETRY:
+			if (number_arg(name, optarg, 0, 86400, &l->retry_seconds))
+				return -1;
+			break;
+		case O_PAUSE:
+			if (number_arg(name, optarg, 0, 3600000, &v))
+				return -1;
+			l->pause_ms = (long)v;
+			break;
+		default: return -1;   /* getopt_long has said what */
+		}
 	}
-	if ((argc - 2) % 2 || !l->server || !l->token || l->clients < 1 || l->count < 1)
+	const char *mode = optind < argc ? argv[optind] : "";
+	if (!strcmp(mode, "claim"))
+		l->mode = LOAD_CLAIM;
+	else if (!strcmp(mode, "get"))
+		l->mode = LOAD_GET;
+	else if (strcmp(mode, "submit")) {
+		fprintf(stderr, *mode ? "poro-load: unknown mode '%s': submit, claim or get\n" : "poro-load: no mode%s\n", mode);
 		return -1;
-	if (l->mode == LOAD_GET)
-		return l->path ? 0 : -1;
-	return l->mode == LOAD_CLAIM || l->case_file ? 0 : -1;
+	}
+	if (optind + 1 < argc) {
+		fprintf(stderr, "poro-load: unexpected argument '%s'\n", argv[optind + 1]);
+		return -1;
+	}
+	const char *missing = !l->server ? "--server URL" : !l->token ? "--token T" : !l->clients ? "--clients C" :
+			      !l->count ? "--count N" : l->mode == LOAD_GET && !l->path ? "--path PATH" :
+			      l->mode == LOAD_SUBMIT && !l->case_file ? "--case FILE" : NULL;
+	if (missing) {
+		fprintf(stderr, "poro-load: %s: missing %s\n", mode, missing);
+		return -1;
+	}
+	return 0;
 }
 
 int main(int argc, char **argv)
 {
 	static struct load l;
 	l.key_prefix = "load";
-	if (parse_args(&l, argc, argv) < 0)
-		return usage();
+	int parsed = parse_args(&l, argc, argv);
+	if (parsed) {
+		if (parsed < 0)
+			usage(stderr);
+		return parsed < 0 ? 2 : 0;
+	}
 	if (l.mode == LOAD_SUBMIT) {
 		json_error_t jerr;
 		json_t *spec = json_load_file(l.case_file, 0, &jerr);

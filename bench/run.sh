@@ -11,6 +11,8 @@ echo "== solver: 2-D elastic block, >= 100,000 soil points, 1 and 2 threads in t
 "$build"/bench/solver_bench
 "$build"/bench/solver_bench --single-point
 "$build"/bench/solver_bench --projection consistent
+echo "== schemes: a consolidation column by each scheme at its own step; the implicit scheme's Newton iterations (bench/scheme_bench.c)"
+"$build"/bench/scheme_bench
 echo "== slope cost: 000 Table 4, single against double point, 6x6 to 24x24 points per cell (bench/slope_cost_bench.c)"
 "$build"/bench/slope_cost_bench
 echo "== service: durable submissions, claims, log delay (bench/service.sh)"

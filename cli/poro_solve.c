@@ -12,15 +12,19 @@
  *                     [--line X0,Y0,X1,Y1[,...][,N] --line-out FILE [--at TIME]]
  *                                        derived quantities of a run (report.h, docs/report.md): a
  *                                        CSV row per frame (toe, run-out, crest settlement, soil-water
- *                                        gap, oscillation index) to stdout or FILE, and the pore
- *                                        pressure along a line at the frame nearest TIME (default the
- *                                        last) to the --line-out FILE
+ *                                        gap, oscillation index, pressure pattern index) to stdout
+ *                                        or FILE, and the pore pressure along a line at the frame
+ *                                        nearest TIME (default the last) to the --line-out FILE
  *   poro-solve probes RESULT.h5 --job ID --attempt N [--out FILE]
  *                                        the probe series of a run as the JSON document the job
  *                                        service serves (docs/service.md §3, GET .../probes):
  *                                        {"job", "attempt", "probes": {name: {"unit", "time",
  *                                        "value"}}}, names in the order of the case, to stdout or FILE
- *   poro-solve version
+ *   poro-solve version | --version | --help;  poro-solve COMMAND --help
+ *
+ * Options are parsed by getopt_long, with GNU habits: "--out DIR" and "--out=DIR", options before
+ * or after the file, "--" ends them. Without arguments the usage goes to stderr (exit 2); the
+ * worker reads it to learn whether this solver knows --checkpoint-wall.
  *
  * run writes DIR/checkpoint.h5 every checkpoint.interval of simulated time (case key) and every
  * --checkpoint-wall seconds of wall time, whichever comes first, and prints
@@ -37,7 +41,9 @@
  * (NaN, a point leaving the grid, a failed factorisation), 4 I/O, 5 out of memory, 6 interrupted.
  * Progress goes to stdout, one line per report; errors to stderr, prefixed "poro-solve: ".
  */
+#define _GNU_SOURCE
 #include <errno.h>
+#include <getopt.h>
 #include <math.h>
 #include <signal.h>
 #include <stdio.h>
@@ -50,6 +56,7 @@
 #include "poro.h"
 #include "report.h"
 #include "results_read.h"
+#include "subcommand.h"
 
 #ifndef PORO_VERSION
 #define PORO_VERSION "unknown"
@@ -63,16 +70,64 @@ static void on_signal(int sig)
 	stop_requested = 1;
 }
 
-static int usage(void)
+#define PROGRAM "poro-solve"
+
+static int parse_run(const struct subcommand *self, int argc, char **argv);
+static int parse_validate(const struct subcommand *self, int argc, char **argv);
+static int parse_element(const struct subcommand *self, int argc, char **argv);
+static int parse_report(const struct subcommand *self, int argc, char **argv);
+static int parse_probes(const struct subcommand *self, int argc, char **argv);
+static int parse_version(const struct subcommand *self, int argc, char **argv);
+
+static const struct subcommand COMMANDS[] = {
+	{ "run", "run CASE.json --out DIR [--resume CHECKPOINT] [--checkpoint-wall SECONDS]",
+	  "Runs a case; writes DIR/result.h5 and DIR/result.xdmf, and DIR/checkpoint.h5 every\n"
+	  "checkpoint.interval of simulated time and every --checkpoint-wall seconds of wall time.\n"
+	  "  -o, --out DIR                 the output directory (required)\n"
+	  "      --resume CHECKPOINT       continue from a checkpoint of the same case, keeping the\n"
+	  "                                frames of DIR/result.h5 up to it\n"
+	  "      --checkpoint-wall SECONDS also write a checkpoint every SECONDS of wall time (> 0)\n",
+	  parse_run },
+	{ "validate", "validate CASE.json",
+	  "Checks a case (a simulation case, or an element case by its \"schema\"): every problem as\n"
+	  "'JSON-pointer: message' on stderr, exit 2 when there is one.\n",
+	  parse_validate },
+	{ "element", "element CASE.json --out DIR",
+	  "A single-element triaxial test (docs/element.md): DIR/element.csv, which poro-plot draws.\n"
+	  "  -o, --out DIR                 the output directory (required)\n",
+	  parse_element },
+	{ "report", "report RESULT.h5 [--out FILE] [--ground Y] [--crest X] [--tolerance M]\n"
+		    "                         [--line X0,Y0,X1,Y1[,...][,N] --line-out FILE [--at TIME]]",
+	  "Derived quantities of a run (docs/report.md): a CSV row per frame (toe, run-out, crest\n"
+	  "settlement, soil-water gap, oscillation index, pressure pattern index) to stdout or FILE, and\n"
+	  "the pore pressure along a line at the frame nearest TIME (default the last) to the --line-out\n"
+	  "FILE.\n"
+	  "  -o, --out FILE                the per-frame table (default stdout)\n"
+	  "      --ground Y, --crest X, --tolerance M   the report's settings, m\n"
+	  "      --line X0,Y0,X1,Y1[,...][,N]           a polyline and its number of samples\n"
+	  "      --line-out FILE           the table of the line (needed with --line)\n"
+	  "      --at TIME                 the time of the line's frame, s\n",
+	  parse_report },
+	{ "probes", "probes RESULT.h5 --job ID --attempt N [--out FILE]",
+	  "The probe series of a run as the JSON document the job service serves (docs/service.md §3):\n"
+	  "{\"job\", \"attempt\", \"probes\": {name: {\"unit\", \"time\", \"value\"}}}, to stdout or FILE.\n"
+	  "      --job ID, --attempt N     the job and attempt the document names (whole numbers >= 0)\n"
+	  "  -o, --out FILE                where to write it (nothing is left there on failure)\n",
+	  parse_probes },
+	{ "version", "version", "Prints \"poro-solve VERSION\" (git describe of the build).\n", parse_version },
+};
+static const int COMMAND_COUNT = (int)(sizeof COMMANDS / sizeof COMMANDS[0]);
+
+static int help(void)
 {
-	fprintf(stderr, "usage: poro-solve run CASE.json --out DIR [--resume CHECKPOINT] [--checkpoint-wall SECONDS]\n"
-			"       poro-solve validate CASE.json\n"
-			"       poro-solve element CASE.json --out DIR\n"
-			"       poro-solve report RESULT.h5 [--out FILE] [--ground Y] [--crest X] [--tolerance M]\n"
-			"                         [--line X0,Y0,X1,Y1[,...][,N] --line-out FILE [--at TIME]]\n"
-			"       poro-solve probes RESULT.h5 --job ID --attempt N [--out FILE]\n"
-			"       poro-solve version\n");
-	return 2;
+	printf("poro-solve: the PoroMPM solver from the command line\n\n");
+	subcommand_list(stdout, PROGRAM, COMMANDS, COMMAND_COUNT);
+	printf("\nExit status:\n");
+#define PORO_STATUS_HELP(code, exit_code, meaning) printf("  %d  %s\n", exit_code, meaning);
+	PORO_STATUS_MAP(PORO_STATUS_HELP)
+#undef PORO_STATUS_HELP
+	printf("  (a bad command line is invalid input: 2)\n");
+	return 0;
 }
 
 static int fail(enum poro_status st, const struct poro_error *err, const char *what)
@@ -89,8 +144,11 @@ static void print_progress(const struct sim_progress *p, void *user)
 		fflush(stdout);
 		return;
 	}
-	printf("step %ld/%ld  t = %.6g s  wall = %.2f s  %.3f us per material-point step\n", p->step,
+	printf("step %ld/%ld  t = %.6g s  wall = %.2f s  %.3f us per material-point step", p->step,
 	       p->steps_total, p->time, p->wall_seconds, p->us_per_point_step);
+	if (p->iterations_mean > 0.0)   /* after the figures the worker reads (worker/log_pump.c) */
+		printf("  Newton iterations %d (mean %.2f)", p->iterations_last, p->iterations_mean);
+	printf("\n");
 	fflush(stdout);
 }
 
@@ -191,6 +249,9 @@ static int cmd_run(const char *path, const struct run_options *opt)
 	sim_set_checkpoint_wall(s, opt->checkpoint_wall);
 	printf("case '%s': %ld soil points, %ld water points, %ld steps\n", c->title,
 	       (long)sim_soil(s)->n, sim_is_double_point(s) ? (long)sim_water(s)->n : 0L, sim_steps_total(s));
+	if (c->time.dt_auto)
+		printf("dt \"auto\": %.6g s, the %s scheme's recommended step\n", c->time.dt,
+		       c->formulation.scheme == SCHEME_EXPLICIT ? "explicit" : "semi-implicit");
 	if (opt->resume)
 		printf("resumed from '%s' at step %ld, t = %.6g s\n", opt->resume, sim_steps_taken(s), sim_time(s));
 	signal(SIGTERM, on_signal);
@@ -208,29 +269,75 @@ static int cmd_run(const char *path, const struct run_options *opt)
 	return code;
 }
 
-/* run CASE.json --out DIR [--resume CHECKPOINT] [--checkpoint-wall SECONDS], options in any order. */
-static int parse_run(int argc, char **argv)
+static int parse_run(const struct subcommand *self, int argc, char **argv)
 {
+	static const struct option opts[] = {
+		{ "out", required_argument, NULL, 'o' },         { "resume", required_argument, NULL, 'r' },
+		{ "checkpoint-wall", required_argument, NULL, 'w' }, { "help", no_argument, NULL, 'h' },
+		{ NULL, 0, NULL, 0 }
+	};
 	struct run_options opt = {0};
-	for (int i = 3; i < argc; i += 2) {
-		if (i + 1 >= argc)
-			return usage();
-		if (!strcmp(argv[i], "--out")) {
-			opt.out_dir = argv[i + 1];
-		} else if (!strcmp(argv[i], "--resume")) {
-			opt.resume = argv[i + 1];
-		} else if (!strcmp(argv[i], "--checkpoint-wall")) {
-			if (parse_number(argv[i + 1], &opt.checkpoint_wall) || !(opt.checkpoint_wall > 0) ||
+	int c, rc;
+	while ((c = getopt_long(argc, argv, "ho:", opts, NULL)) != -1) {
+		switch (c) {
+		case 'h': return subcommand_help(PROGRAM, self);
+		case 'o': opt.out_dir = optarg; break;
+		case 'r': opt.resume = optarg; break;
+		case 'w':
+			if (parse_number(optarg, &opt.checkpoint_wall) || !(opt.checkpoint_wall > 0) ||
 			    opt.checkpoint_wall > 1e9) {
-				fprintf(stderr, "poro-solve: --checkpoint-wall: '%s' is not a number of seconds > 0\n",
-					argv[i + 1]);
+				fprintf(stderr, "poro-solve: --checkpoint-wall: '%s' is not a number of seconds > 0\n", optarg);
 				return 2;
 			}
-		} else {
-			return usage();
+			break;
+		default: return subcommand_usage_error(PROGRAM, self, NULL);
 		}
 	}
-	return opt.out_dir ? cmd_run(argv[2], &opt) : usage();
+	if ((rc = subcommand_positional(PROGRAM, self, argc, argv, 1, "CASE.json")))
+		return rc;
+	if (!opt.out_dir)
+		return subcommand_usage_error(PROGRAM, self, "missing --out DIR");
+	return cmd_run(argv[optind], &opt);
+}
+
+static int parse_validate(const struct subcommand *self, int argc, char **argv)
+{
+	static const struct option opts[] = { { "help", no_argument, NULL, 'h' }, { NULL, 0, NULL, 0 } };
+	int c = getopt_long(argc, argv, "h", opts, NULL), rc;
+	if (c != -1)
+		return c == 'h' ? subcommand_help(PROGRAM, self) : subcommand_usage_error(PROGRAM, self, NULL);
+	return (rc = subcommand_positional(PROGRAM, self, argc, argv, 1, "CASE.json")) ? rc : cmd_validate(argv[optind]);
+}
+
+static int parse_element(const struct subcommand *self, int argc, char **argv)
+{
+	static const struct option opts[] = {
+		{ "out", required_argument, NULL, 'o' }, { "help", no_argument, NULL, 'h' }, { NULL, 0, NULL, 0 }
+	};
+	const char *out = NULL;
+	int c, rc;
+	while ((c = getopt_long(argc, argv, "ho:", opts, NULL)) != -1) {
+		if (c == 'h')
+			return subcommand_help(PROGRAM, self);
+		if (c != 'o')
+			return subcommand_usage_error(PROGRAM, self, NULL);
+		out = optarg;
+	}
+	if ((rc = subcommand_positional(PROGRAM, self, argc, argv, 1, "CASE.json")))
+		return rc;
+	return out ? cmd_element(argv[optind], out) : subcommand_usage_error(PROGRAM, self, "missing --out DIR");
+}
+
+static int parse_version(const struct subcommand *self, int argc, char **argv)
+{
+	static const struct option opts[] = { { "help", no_argument, NULL, 'h' }, { NULL, 0, NULL, 0 } };
+	int c = getopt_long(argc, argv, "h", opts, NULL), rc;
+	if (c != -1)
+		return c == 'h' ? subcommand_help(PROGRAM, self) : subcommand_usage_error(PROGRAM, self, NULL);
+	if ((rc = subcommand_positional(PROGRAM, self, argc, argv, 0, "")))
+		return rc;
+	printf("poro-solve %s\n", PORO_VERSION);
+	return 0;
 }
 
 /* What `report` was asked for besides the result file. */
@@ -304,42 +411,43 @@ static int cmd_report(const char *path, const struct report_options *opt)
 	return code;
 }
 
-/* One refused command line of `report`: the problem, then the usage. */
-static int report_usage(const char *problem, const char *subject)
+/* report RESULT.h5 [options] (struct report_options). */
+static int parse_report(const struct subcommand *self, int argc, char **argv)
 {
-	fprintf(stderr, "poro-solve: report: %s '%s'\n", problem, subject);
-	return usage();
-}
-
-/* report RESULT.h5 [options], options in any order (struct report_options). */
-static int parse_report(int argc, char **argv)
-{
+	static const struct option opts[] = {
+		{ "out", required_argument, NULL, 'o' },   { "ground", required_argument, NULL, 'g' },
+		{ "crest", required_argument, NULL, 'c' }, { "tolerance", required_argument, NULL, 't' },
+		{ "at", required_argument, NULL, 'a' },    { "line", required_argument, NULL, 'l' },
+		{ "line-out", required_argument, NULL, 'L' }, { "help", no_argument, NULL, 'h' },
+		{ NULL, 0, NULL, 0 }
+	};
 	struct report_options opt = {.at = NAN, .settings = REPORT_SETTINGS_DEFAULT};
-	for (int i = 3; i < argc; i += 2) {
-		const char *key = argv[i], *value = i + 1 < argc ? argv[i + 1] : NULL;
-		double *number = !strcmp(key, "--ground") ? &opt.settings.ground :
-				 !strcmp(key, "--crest") ? &opt.settings.crest :
-				 !strcmp(key, "--tolerance") ? &opt.settings.tolerance :
-				 !strcmp(key, "--at") ? &opt.at : NULL;
-		const char **text = !strcmp(key, "--out") ? &opt.out :
-				    !strcmp(key, "--line") ? &opt.line :
-				    !strcmp(key, "--line-out") ? &opt.line_out : NULL;
-		if (!number && !text)
-			return report_usage("unknown option", key);
-		if (!value)
-			return report_usage("no value after", key);
-		if (number && parse_number(value, number)) {
-			fprintf(stderr, "poro-solve: %s: '%s' is not a number\n", key, value);
+	int c, index = 0, rc;
+	while ((c = getopt_long(argc, argv, "ho:", opts, &index)) != -1) {
+		double *number = c == 'g' ? &opt.settings.ground : c == 'c' ? &opt.settings.crest :
+				 c == 't' ? &opt.settings.tolerance : c == 'a' ? &opt.at : NULL;
+		if (c == 'h')
+			return subcommand_help(PROGRAM, self);
+		else if (c == 'o')
+			opt.out = optarg;
+		else if (c == 'l')
+			opt.line = optarg;
+		else if (c == 'L')
+			opt.line_out = optarg;
+		else if (!number)
+			return subcommand_usage_error(PROGRAM, self, NULL);
+		else if (parse_number(optarg, number)) {
+			fprintf(stderr, "poro-solve: --%s: '%s' is not a number\n", opts[index].name, optarg);
 			return 2;
 		}
-		if (text)
-			*text = value;
 	}
+	if ((rc = subcommand_positional(PROGRAM, self, argc, argv, 1, "RESULT.h5")))
+		return rc;
 	if (opt.line && !opt.line_out)
-		return report_usage("no --line-out FILE for", "--line");
+		return subcommand_usage_error(PROGRAM, self, "no --line-out FILE for '--line'");
 	if (!opt.line && (opt.line_out || !isnan(opt.at)))
-		return report_usage("no --line for", opt.line_out ? "--line-out" : "--at");
-	return cmd_report(argv[2], &opt);
+		return subcommand_usage_error(PROGRAM, self, "no --line for '%s'", opt.line_out ? "--line-out" : "--at");
+	return cmd_report(argv[optind], &opt);
 }
 
 /* ---- probes ---------------------------------------------------------------------------------- */
@@ -457,38 +565,35 @@ static int parse_count(const char *key, const char *text, long long *value)
 	return 0;
 }
 
-/* probes RESULT.h5 --job ID --attempt N [--out FILE], options in any order. */
-static int parse_probes(int argc, char **argv)
+/* probes RESULT.h5 --job ID --attempt N [--out FILE]. */
+static int parse_probes(const struct subcommand *self, int argc, char **argv)
 {
+	static const struct option opts[] = {
+		{ "job", required_argument, NULL, 'j' }, { "attempt", required_argument, NULL, 'a' },
+		{ "out", required_argument, NULL, 'o' }, { "help", no_argument, NULL, 'h' }, { NULL, 0, NULL, 0 }
+	};
 	long long job = -1, attempt = -1;
 	const char *out = NULL;
-	for (int i = 3; i < argc; i += 2) {
-		const char *key = argv[i], *value = i + 1 < argc ? argv[i + 1] : NULL;
-		if (!value || (strcmp(key, "--job") && strcmp(key, "--attempt") && strcmp(key, "--out")))
-			return usage();
-		if (!strcmp(key, "--out"))
-			out = value;
-		else if (parse_count(key, value, !strcmp(key, "--job") ? &job : &attempt))
-			return 2;
+	int c, rc;
+	while ((c = getopt_long(argc, argv, "ho:", opts, NULL)) != -1) {
+		if (c == 'h')
+			return subcommand_help(PROGRAM, self);
+		else if (c == 'o')
+			out = optarg;
+		else if (c == 'j' || c == 'a') {
+			if (parse_count(c == 'j' ? "--job" : "--attempt", optarg, c == 'j' ? &job : &attempt))
+				return 2;
+		} else
+			return subcommand_usage_error(PROGRAM, self, NULL);
 	}
-	return job < 0 || attempt < 0 ? usage() : cmd_probes(argv[2], job, attempt, out);
+	if ((rc = subcommand_positional(PROGRAM, self, argc, argv, 1, "RESULT.h5")))
+		return rc;
+	if (job < 0 || attempt < 0)
+		return subcommand_usage_error(PROGRAM, self, "missing %s", job < 0 ? "--job ID" : "--attempt N");
+	return cmd_probes(argv[optind], job, attempt, out);
 }
 
 int main(int argc, char **argv)
 {
-	if (argc >= 2 && !strcmp(argv[1], "version")) {
-		printf("poro-solve %s\n", PORO_VERSION);
-		return 0;
-	}
-	if (argc == 3 && !strcmp(argv[1], "validate"))
-		return cmd_validate(argv[2]);
-	if (argc >= 3 && !strcmp(argv[1], "run"))
-		return parse_run(argc, argv);
-	if (argc >= 3 && !strcmp(argv[1], "report"))
-		return parse_report(argc, argv);
-	if (argc >= 3 && !strcmp(argv[1], "probes"))
-		return parse_probes(argc, argv);
-	if (argc == 5 && !strcmp(argv[1], "element") && !strcmp(argv[3], "--out"))
-		return cmd_element(argv[2], argv[4]);
-	return usage();
+	return subcommand_main(PROGRAM, PORO_VERSION, COMMANDS, COMMAND_COUNT, help, argc, argv);
 }

@@ -297,6 +297,7 @@ static long perform(struct transfer *t, struct curl_slist *headers)
 			snprintf(r->error, sizeof r->error, "answer larger than %ld bytes", (long)HTTP_MAX_BODY);
 		else
 			snprintf(r->error, sizeof r->error, "%s", curl_error[0] ? curl_error : curl_easy_strerror(rc));
+		r->local = t->write_failed;
 	} else {
 		r->status = code;
 	}
@@ -332,6 +333,7 @@ long http_json(struct http_client *c, const char *method, const char *path, cons
 		text = json_dumps(body, JSON_COMPACT);
 		if (!text) {
 			curl_slist_free_all(headers);
+			r->local = 1;
 			snprintf(r->error, sizeof r->error, "cannot encode the request body");
 			return 0;
 		}
@@ -359,6 +361,7 @@ long http_download(struct http_client *c, const char *path, const char *dest, ch
 	transfer_init(&t, c, r);
 	t.file = fopen(dest, "wb");
 	if (!t.file) {
+		r->local = 1;
 		snprintf(r->error, sizeof r->error, "cannot create '%s': %s", dest, strerror(errno));
 		return 0;
 	}
@@ -366,6 +369,7 @@ long http_download(struct http_client *c, const char *path, const char *dest, ch
 	if (!t.digest) {
 		fclose(t.file);
 		remove(dest);
+		r->local = 1;
 		snprintf(r->error, sizeof r->error, "out of memory");
 		return 0;
 	}
@@ -374,6 +378,7 @@ long http_download(struct http_client *c, const char *path, const char *dest, ch
 	curl_easy_setopt(c->curl, CURLOPT_LOW_SPEED_TIME, (long)HTTP_STALL_SECONDS);
 	long status = perform(&t, headers);
 	if (fclose(t.file) != 0 && http_ok(r)) {
+		r->local = 1;
 		snprintf(r->error, sizeof r->error, "cannot write '%s': %s", dest, strerror(errno));
 		r->status = 0;
 		status = 0;
@@ -400,11 +405,13 @@ long http_upload(struct http_client *c, const char *path, const char *src, const
 	transfer_init(&t, c, r);
 	FILE *f = fopen(src, "rb");
 	if (!f) {
+		r->local = 1;
 		snprintf(r->error, sizeof r->error, "cannot open '%s': %s", src, strerror(errno));
 		return 0;
 	}
 	if (fseeko(f, 0, SEEK_END) != 0) {
 		fclose(f);
+		r->local = 1;
 		snprintf(r->error, sizeof r->error, "cannot read '%s': %s", src, strerror(errno));
 		return 0;
 	}

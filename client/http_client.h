@@ -9,7 +9,8 @@
  *
  * Every call fills a struct http_response: the HTTP status (0 when no answer came: connection
  * refused, timeout, abort), the parsed JSON body when the answer is JSON, and for an error answer
- * the server's {"error": {"code", "message", "field"}} copied into code, error and field. Calls
+ * the server's {"error": {"code", "message", "field"}} copied into code, error and field (the
+ * whole error object stays in json, with "problems" of an invalid case). Calls
  * return the status, so `if (http_json(...) == 200)` reads naturally. Nothing here prints.
  */
 #ifndef PORO_HTTP_CLIENT_H
@@ -34,6 +35,9 @@ struct http_response {
 	char error[512];              /* why it failed: transport error or the server's message */
 	char code[64];                /* the server's error.code, "" when none */
 	char field[256];              /* the server's error.field, "" when none or null */
+	int local;                    /* 1 when the call failed on this side (a file that cannot be
+				       * opened, created or written, no memory): status 0, yet not for
+				       * want of an answer */
 };
 
 /* Called once per line of a streamed answer, without the newline; a last line without a newline

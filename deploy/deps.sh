@@ -17,9 +17,14 @@ packages=(
   libcurl4-openssl-dev  # worker and CLI HTTP client
   python3               # test harness helpers
   python3-matplotlib python3-h5py  # poro-plot: pictures of a run from its result.h5
+  python3-jsonschema    # tests/cli/schema_test.sh: the case schemas against the solver's loader
+                        # (Debian 12's 4.10 knows JSON Schema draft 2020-12)
   python3-paraview      # ParaView's own XDMF readers, which tests/cli/paraview_test.sh opens
                         # result.xdmf with (no display needed: readers only)
   curl procps           # the service tests speak HTTP with curl and find processes with pgrep
+  systemd               # systemd-analyze: tests/install/install_test.sh verifies the installed units
+                        # (no systemd needs to run for that)
+  man-db                # man -l: the same test renders the installed man pages
 )
 
 # The OpenAPI linter of make test (tools/openapi-lint, pinned in its package-lock.json) runs on

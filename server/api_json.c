@@ -11,7 +11,12 @@
 
 json_t *api_body_object(struct request *r)
 {
+	/* jansson sets the error's code only where it reports an error: when it runs out of memory
+	 * before reading (its lexer's buffer), it returns NULL with the code left as it found it, so
+	 * an uninitialised one read as a client's error and answered 400 under memory pressure.
+	 * Zeroed, the code is json_error_unknown there, which answers 503 below. */
 	json_error_t je;
+	memset(&je, 0, sizeof je);
 	if (!r->body || r->body_size == 0) {
 		reply_fail(r, API_INVALID_JSON, "", "request body is empty: expected a JSON object");
 		return NULL;
@@ -24,9 +29,9 @@ json_t *api_body_object(struct request *r)
 		 * out of memory midway, which it reports as whatever syntax error the half-read token
 		 * makes ("invalid token", "string or '}' expected", line -1). */
 		enum json_error_code code = json_error_code(&je);
-		int clients = code == json_error_invalid_utf8 || code == json_error_null_character ||
+		int clients = je.text[0] != '\0' && (code == json_error_invalid_utf8 || code == json_error_null_character ||
 			      code == json_error_duplicate_key || code == json_error_numeric_overflow ||
-			      (code == json_error_invalid_syntax && strncmp(je.text, "invalid Unicode", 15) == 0);
+			      (code == json_error_invalid_syntax && strncmp(je.text, "invalid Unicode", 15) == 0));
 		if (!clients) {
 			reply_header(r, "Retry-After", "1");
 			reply_fail(r, API_UNAVAILABLE, "", "no memory to read a request body of %zu bytes: retry later",

@@ -26,6 +26,7 @@
  * ranges or a malformed one is ignored and the whole file sent, as RFC 9110 allows.
  */
 #include "api.h"
+#include "log.h"
 
 #include "digest.h"
 
@@ -96,8 +97,7 @@ static void damaged_record(const struct copy_key *k, const char *what)
 	if (damaged.count < DAMAGED_REMEMBERED)
 		damaged.count++;
 	pthread_mutex_unlock(&damaged.lock);
-	fprintf(stderr, "poro-server: damaged stored file: job %lld attempt %d '%s': %s\n", k->id, k->attempt, k->name,
-		what);
+	log_say(LOG_PRIO_ERR, "damaged stored file: job %lld attempt %d '%s': %s", k->id, k->attempt, k->name, what);
 }
 
 static void reply_damaged(struct request *r, const struct copy_key *k, const char *what)

@@ -19,6 +19,7 @@
 #define _GNU_SOURCE /* accept4, POLLRDHUP */
 #include "front_door.h"
 
+#include "log.h"
 #include "metrics.h"
 #include "request_head.h"
 #include "store.h"
@@ -148,6 +149,28 @@ static const char *reason_phrase(int status)
 
 static void stop_waiting(struct front_door *d, int i, int close_fd);
 
+/* An answer of the front door's own in the server's log (log.h): a request line with no method,
+ * route, user or duration, which are not known before the head is handed over, the error code and
+ * by=front_door. The head itself is never logged: it may hold a token. */
+static void log_answer(int fd, int status, enum api_code code)
+{
+	struct sockaddr_storage addr;
+	socklen_t addr_len = sizeof addr;
+	char client[INET6_ADDRSTRLEN] = "-";
+	if (getpeername(fd, (struct sockaddr *)&addr, &addr_len) == 0)
+		getnameinfo((struct sockaddr *)&addr, addr_len, client, sizeof client, NULL, 0, NI_NUMERICHOST);
+	struct log_line l;
+	log_line_begin_request(&l, status >= 500 ? LOG_PRIO_WARNING : LOG_PRIO_INFO);
+	log_line_str(&l, "method", "-");
+	log_line_str(&l, "route", "-");
+	log_line_int(&l, "status", status);
+	log_line_str(&l, "user", "-");
+	log_line_str(&l, "client", client);
+	log_line_str(&l, "code", api_code_name(code));
+	log_line_str(&l, "by", "front_door");
+	log_line_end(&l);
+}
+
 /* Writes a whole HTTP answer with the API's JSON error to fd and says the connection closes.
  * Allocates nothing, so it works when memory has run out: the message is escaped into a buffer on
  * the stack (the front door's messages are its own text, so nothing needs more than a backslash). */
@@ -172,6 +195,7 @@ static void write_answer(struct front_door *d, int fd, int status, enum api_code
 	if (send(fd, head, (size_t)head_size, MSG_NOSIGNAL) == head_size)
 		(void)send(fd, body, (size_t)size, MSG_NOSIGNAL);
 	metrics_count_request(d->srv->metrics, status);
+	log_answer(fd, status, code);
 }
 
 /* Answers a waiting connection with a JSON error and lingers, or closes it at once when the waiting

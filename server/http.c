@@ -27,6 +27,7 @@
 #include "api.h"
 #include "front_door.h"
 #include "http.h"
+#include "log.h"
 #include "metrics.h"
 #include "request_gate.h"
 #include "store.h"
@@ -36,6 +37,7 @@
 
 #include <microhttpd.h>
 #include <errno.h>
+#include <netdb.h>
 #include <malloc.h>
 #include <stdarg.h>
 #include <stdio.h>
@@ -114,27 +116,54 @@ struct exchange {
 	int scan_failed;              /* the scan refused the body: discard the rest */
 	long long received;
 	size_t capacity;
-	struct timespec started;      /* arrival, for the access log */
+	struct timespec started;      /* arrival, for the request's log line */
+	int status;                   /* the status queued, once queued */
 };
 
-/* One line per answered request to --access-log: "METHOD ROUTE STATUS MILLISECONDS", ROUTE the
- * pattern of docs/service.md (the raw path when no route matched), so tests can check that every
- * route of schemas/openapi.yaml was exercised. One write(2) on an O_APPEND descriptor per line,
- * so lines from concurrent connections do not interleave. */
-static void access_log(const struct exchange *x, int status)
+static const char *ended_name(enum MHD_RequestTerminationCode toe)
+{
+	switch (toe) {
+	case MHD_REQUEST_TERMINATED_COMPLETED_OK: return NULL;
+	case MHD_REQUEST_TERMINATED_WITH_ERROR: return "error";
+	case MHD_REQUEST_TERMINATED_TIMEOUT_REACHED: return "timeout";
+	case MHD_REQUEST_TERMINATED_DAEMON_SHUTDOWN: return "shutdown";
+	case MHD_REQUEST_TERMINATED_READ_ERROR: return "read_error";
+	case MHD_REQUEST_TERMINATED_CLIENT_ABORT: return "client_abort";
+	default: return "other";
+	}
+}
+
+/* The request's line in the server's log (log.h), when the request ends: its method, route
+ * pattern ("-" when no route matched: a raw path or query string may hold anything, a token
+ * included, so neither is ever logged), the status answered (none when the request ended before
+ * an answer), milliseconds from its arrival to its end (a streamed answer's too), the
+ * authenticated user ("-" without one), the client's address and, when it did not end normally,
+ * how it ended. 5xx answers are warnings. --access-log gets the same line; the route-coverage
+ * check reads it there. */
+static void log_request(const struct exchange *x, enum MHD_RequestTerminationCode toe)
 {
 	const struct request *r = &x->req;
-	if (r->srv->access_log_fd < 0)
-		return;
 	struct timespec now;
 	clock_gettime(CLOCK_MONOTONIC, &now);
 	double ms = (double)(now.tv_sec - x->started.tv_sec) * 1e3 + (double)(now.tv_nsec - x->started.tv_nsec) * 1e-6;
-	char line[600];
-	int n = snprintf(line, sizeof line, "%s %s %d %.3f\n", r->method, r->route ? r->route->pattern : r->url,
-			 status, ms);
-	if (n > 0 && (size_t)n < sizeof line && write(r->srv->access_log_fd, line, (size_t)n) < 0) {
-		/* a lost log line must not fail the request */
-	}
+	char client[INET6_ADDRSTRLEN] = "-";
+	const union MHD_ConnectionInfo *info =
+		MHD_get_connection_info(r->connection, MHD_CONNECTION_INFO_CLIENT_ADDRESS);
+	if (info && info->client_addr)
+		getnameinfo(info->client_addr,
+			    info->client_addr->sa_family == AF_INET6 ? sizeof(struct sockaddr_in6) : sizeof(struct sockaddr_in),
+			    client, sizeof client, NULL, 0, NI_NUMERICHOST);
+	struct log_line l;
+	log_line_begin_request(&l, x->status >= 500 ? LOG_PRIO_WARNING : LOG_PRIO_INFO);
+	log_line_str(&l, "method", r->method);
+	log_line_str(&l, "route", r->route ? r->route->pattern : "-");
+	if (x->queued)
+		log_line_int(&l, "status", x->status);
+	log_line_ms(&l, "duration_ms", ms);
+	log_line_str(&l, "user", r->who.role ? r->who.name : "-");
+	log_line_str(&l, "client", client);
+	log_line_str(&l, "ended", ended_name(toe));
+	log_line_end(&l);
 }
 
 /* ---- helpers for handlers ---- */
@@ -352,7 +381,7 @@ static enum MHD_Result queue_reply(struct exchange *x)
 	enum MHD_Result ok = MHD_queue_response(r->connection, (unsigned)rep->status, resp);
 	MHD_destroy_response(resp);
 	metrics_count_request(r->srv->metrics, rep->status);
-	access_log(x, rep->status);
+	x->status = rep->status;
 	x->queued = 1;
 	return ok;
 }
@@ -654,6 +683,7 @@ static void on_completed(void *cls, struct MHD_Connection *connection, void **co
 	struct exchange *x = *con_cls;
 	if (!x)
 		return;
+	log_request(x, toe);
 	if (x->upload_started && x->req.route->upload_abort)
 		x->req.route->upload_abort(&x->req);
 	if (x->token_counted)
@@ -695,6 +725,15 @@ static void on_connection(void *cls, struct MHD_Connection *connection, void **s
 	}
 }
 
+/* libmicrohttpd's own error messages (MHD_USE_ERROR_LOG) go to the server's log as warnings. */
+static void engine_log(void *cls, const char *fmt, va_list ap)
+{
+	char text[LOG_LINE_MAX];
+	vsnprintf(text, sizeof text, fmt, ap);
+	text[strcspn(text, "\n")] = '\0';
+	log_say(LOG_PRIO_WARNING, "libmicrohttpd: %s", text);
+}
+
 /* The front door's hand-over: libmicrohttpd closes the socket itself when it refuses it. */
 static int admit(void *cls, int fd, const struct sockaddr *addr, socklen_t addr_len)
 {
@@ -719,15 +758,16 @@ void *http_start(struct server *srv, char *url, size_t url_size, char *msg, size
 		return NULL;
 	}
 	/* no listening socket: connections come from the front door. The engine's own connection
-	 * limit sits above the front door's budgets, so it never refuses one the front door admitted. */
+	 * limit sits above the front door's budgets, so it never refuses one the front door admitted.
+	 * The logger comes first: libmicrohttpd reports problems with the options after it through it. */
 	unsigned flags = MHD_USE_THREAD_PER_CONNECTION | MHD_USE_INTERNAL_POLLING_THREAD | MHD_USE_POLL |
 			 MHD_USE_ITC | MHD_USE_ERROR_LOG | MHD_USE_NO_LISTEN_SOCKET;
 	h->daemon = MHD_start_daemon(
-		flags, 0, NULL, NULL, on_request, h, MHD_OPTION_CONNECTION_LIMIT, (unsigned)(connections + 64),
-		MHD_OPTION_NOTIFY_COMPLETED, on_completed, h, MHD_OPTION_NOTIFY_CONNECTION, on_connection, h,
-		MHD_OPTION_UNESCAPE_CALLBACK, no_unescape, NULL, MHD_OPTION_CONNECTION_TIMEOUT,
-		(unsigned)CONNECTION_TIMEOUT_SECONDS, MHD_OPTION_CONNECTION_MEMORY_LIMIT, (size_t)CONNECTION_MEMORY,
-		MHD_OPTION_THREAD_STACK_SIZE, (size_t)THREAD_STACK_BYTES, MHD_OPTION_END);
+		flags, 0, NULL, NULL, on_request, h, MHD_OPTION_EXTERNAL_LOGGER, engine_log, NULL,
+		MHD_OPTION_CONNECTION_LIMIT, (unsigned)(connections + 64), MHD_OPTION_NOTIFY_COMPLETED, on_completed, h,
+		MHD_OPTION_NOTIFY_CONNECTION, on_connection, h, MHD_OPTION_UNESCAPE_CALLBACK, no_unescape, NULL,
+		MHD_OPTION_CONNECTION_TIMEOUT, (unsigned)CONNECTION_TIMEOUT_SECONDS, MHD_OPTION_CONNECTION_MEMORY_LIMIT,
+		(size_t)CONNECTION_MEMORY, MHD_OPTION_THREAD_STACK_SIZE, (size_t)THREAD_STACK_BYTES, MHD_OPTION_END);
 	if (!h->daemon) {
 		snprintf(msg, msg_size, "cannot start the HTTP engine");
 		http_stop(h);

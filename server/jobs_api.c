@@ -10,7 +10,10 @@
  * the total). The case is stored in canonical form (json_dumps with JSON_COMPACT |
  * JSON_SORT_KEYS: the loader's c->json), and case_sha256 is the SHA-256 of that text. The
  * idempotency comparison uses the SHA-256 of the whole request in the same canonical form, so key
- * order and white space do not make two identical requests differ.
+ * order and white space do not make two identical requests differ. A valid case's warnings (values
+ * the loader allows but that are most likely not what was meant, case.h) are answered with the
+ * job, as "warnings" [{"field", "message"}] beside the 201 or 200, so that a user who submits over
+ * HTTP learns what `poro-solve validate` would have printed; they are not stored.
  */
 #include "api.h"
 #include "store.h"
@@ -32,8 +35,9 @@
 #define LIST_LIMIT_DEFAULT 100
 #define ID_MAX 999999999999999999LL
 
-/* Turns the loader's "pointer: message" lines into problems under /case; the loader's last line
- * "... and N more problems" is not a problem of its own (the total is case_problem_count's). */
+/* Turns the loader's "pointer: message" lines (its problems, or a valid case's warnings) into
+ * [{"field": "/case<pointer>", "message"}]; the loader's last line "... and N more problems" is not
+ * a problem of its own (the total is case_problem_count's). */
 static json_t *case_problems(const char *message)
 {
 	json_t *problems = json_array();
@@ -137,6 +141,7 @@ static int idempotency_key(struct request *r, const char **key)
 struct submission {
 	char *canonical;                 /* the case in canonical form, owned */
 	char *name;                      /* owned, or NULL */
+	json_t *warnings;                /* the case's warnings as [{field, message}], owned */
 	const char *key;                 /* the Idempotency-Key header, or NULL */
 	long long priority, threads, wall;
 	char case_sha[DIGEST_HEX_SIZE], body_sha[DIGEST_HEX_SIZE];
@@ -146,6 +151,7 @@ static void submission_release(struct submission *s)
 {
 	free(s->canonical);
 	free(s->name);
+	json_decref(s->warnings);
 }
 
 /* The costly part of a submission: parses the body, checks the request and validates the case,
@@ -175,7 +181,8 @@ static int submission_check(struct request *r, struct submission *s)
 		goto done;
 	whole = json_dumps(body, JSON_COMPACT | JSON_SORT_KEYS);
 	s->name = name ? strdup(name) : NULL;
-	if (!whole || (name && !s->name)) {
+	s->warnings = case_problems(loaded->warnings);
+	if (!whole || (name && !s->name) || !s->warnings) {
 		reply_fail(r, API_UNAVAILABLE, "", "no memory to store the case: retry later");
 		goto done;
 	}
@@ -222,6 +229,8 @@ void jobs_submit(struct request *r)
 		snprintf(location, sizeof location, "/v1/jobs/%lld",
 			 (long long)json_integer_value(json_object_get(job, "id")));
 		reply_header(r, "Location", location);
+		json_object_set_new(job, "warnings", s.warnings);   /* the answer's, not stored */
+		s.warnings = NULL;
 		reply_json(r, created ? 201 : 200, job);
 	}
 	submission_release(&s);

@@ -9,6 +9,7 @@
  * the rows removed.
  */
 #include "api.h"
+#include "log.h"
 #include "file_sweep.h"
 #include "store.h"
 
@@ -26,8 +27,9 @@ void jobs_delete(struct request *r)
 	}
 	long long disk = 0;
 	if (file_sweep_job(r->srv->cfg.state, r->id, &disk) != 0)
-		fprintf(stderr, "poro-server: cannot remove all files of deleted job %lld: %s (the next start-up removes them)\n",
-			r->id, strerror(errno));
+		log_say(LOG_PRIO_WARNING,
+			"cannot remove all files of deleted job %lld: %s (the next start-up removes them)", r->id,
+			strerror(errno));
 	reply_json(r, 200, json_pack("{s:I, s:b, s:I, s:I, s:I, s:I, s:I}", "id", (json_int_t)r->id, "deleted", 1,
 				     "freed_bytes", (json_int_t)f.bytes, "files", (json_int_t)f.files,
 				     "log_chunks", (json_int_t)f.log_chunks, "events", (json_int_t)f.events,

@@ -11,10 +11,13 @@
  * and the upload path report as an error answer, instead of killing the server.
  *
  * Every option is one row of OPTIONS: the flag name, which is also the key in the config file
- * ("name = value" lines, '#' comments), the field it sets, its default and its help text.
+ * ("name = value" lines, '#' comments), the field it sets, its default and its help text. The
+ * command line is read by getopt_long (--opt=value or --opt value, abbreviations, "--"); --help
+ * and --version print on stdout and exit 0, a bad command line or config file exits 2.
  */
 #include "file_sweep.h"
 #include "http.h"
+#include "log.h"
 #include "metrics.h"
 #include "reaper.h"
 #include "state_dir.h"
@@ -25,8 +28,10 @@
 
 #include <errno.h>
 #include <fcntl.h>
+#include <getopt.h>
 #include <malloc.h>
 #include <signal.h>
+#include <stdarg.h>
 #include <stddef.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -41,6 +46,7 @@ enum option_type { OPT_TEXT, OPT_INT, OPT_LONG };
 
 struct option_def {
 	const char *name;
+	const char *arg;         /* the value's name in --help */
 	enum option_type type;
 	size_t offset;           /* in struct server_config */
 	size_t size;             /* OPT_TEXT: buffer size */
@@ -48,13 +54,13 @@ struct option_def {
 	const char *help;
 };
 
-#define TEXT_OPT(n, f, h) { n, OPT_TEXT, offsetof(struct server_config, f), sizeof((struct server_config *)0)->f, 0, 0, h }
-#define INT_OPT(n, f, lo, hi, h) { n, OPT_INT, offsetof(struct server_config, f), 0, lo, hi, h }
-#define LONG_OPT(n, f, lo, hi, h) { n, OPT_LONG, offsetof(struct server_config, f), 0, lo, hi, h }
+#define TEXT_OPT(n, a, f, h) { n, a, OPT_TEXT, offsetof(struct server_config, f), sizeof((struct server_config *)0)->f, 0, 0, h }
+#define INT_OPT(n, f, lo, hi, h) { n, "N", OPT_INT, offsetof(struct server_config, f), 0, lo, hi, h }
+#define LONG_OPT(n, f, lo, hi, h) { n, "N", OPT_LONG, offsetof(struct server_config, f), 0, lo, hi, h }
 
 static const struct option_def OPTIONS[] = {
-	TEXT_OPT("listen", listen, "HOST:PORT to listen on; port 0 picks a free one (default 127.0.0.1:8080)"),
-	TEXT_OPT("state", state, "state directory: poro.db, files/, server.url (default ./var)"),
+	TEXT_OPT("listen", "HOST:PORT", listen, "HOST:PORT to listen on; port 0 picks a free one (default 127.0.0.1:8080)"),
+	TEXT_OPT("state", "DIR", state, "state directory: poro.db, files/, server.url (default ./var)"),
 	INT_OPT("max-connections", max_connections, 1, 100000, "connections of users and clients without a token, one thread each (default 512)"),
 	INT_OPT("max-worker-connections", max_worker_connections, 1, 100000, "connections of worker tokens on /v1/worker/ routes, kept apart (default 256)"),
 	INT_OPT("max-connections-per-client", max_connections_per_client, 1, 100000, "user connections from one client address, waiting ones included (default 128)"),
@@ -74,7 +80,7 @@ static const struct option_def OPTIONS[] = {
 	INT_OPT("max-backoff-seconds", max_backoff_seconds, 1, 86400, "cap of the retry backoff min(2^(attempt-1), cap) (default 60)"),
 	INT_OPT("group-commit-max", group_commit_max, 1, 100000, "most write requests in one transaction (default 1024)"),
 	INT_OPT("max-job-threads", max_job_threads, 1, 256, "most threads a job may ask for (default 64)"),
-	TEXT_OPT("access-log", access_log, "append 'METHOD ROUTE STATUS MILLISECONDS' per request to FILE (default none)"),
+	TEXT_OPT("access-log", "FILE", access_log, "append the log's request lines (logfmt) to FILE too (default none)"),
 	LONG_OPT("max-log-bytes", max_log_bytes, 65536, 1LL << 50, "log text kept per attempt: its first and last half (default 67108864)"),
 	LONG_OPT("user-max-stored-bytes", user_max_stored_bytes, 0, 1LL << 60, "default per-user cap on stored bytes (cases, logs, files), 0 = unlimited (default 2147483648)"),
 	INT_OPT("min-free-mb", min_free_mb, 0, 1 << 30, "/healthz is degraded below this free space on the state file system, MiB (default 64)"),
@@ -93,21 +99,30 @@ static const struct server_config CONFIG_DEFAULTS = {
 	.min_free_mb = 64,
 };
 
-static void usage(FILE *out)
+static void usage(void)
 {
-	fprintf(out, "usage: poro-server [--config FILE] [--OPTION VALUE ...]\n"
-		     "       poro-server token create --state DIR --user NAME --role user|worker|admin [--label TEXT]\n"
-		     "       poro-server token list --state DIR\n"
-		     "       poro-server token revoke --state DIR --id N\n\n"
-		     "The HTTP job server of PoroMPM (docs/service.md). Every option may also be a line\n"
-		     "'name = value' in the config file; flags win over the file.\n\n"
-		     "options:\n  --config FILE  read options from FILE\n");
-	for (size_t i = 0; i < OPTION_COUNT; i++)
-		fprintf(out, "  --%-20s %s\n", OPTIONS[i].name, OPTIONS[i].help);
-	fprintf(out, "  --help                 this text\n  --version              print the version\n");
+	printf("usage: poro-server [--config=FILE] [--OPTION=VALUE ...]\n"
+	       "       poro-server token create --state=DIR --user=NAME --role=user|worker|admin [--label=TEXT]\n"
+	       "       poro-server token list --state=DIR\n"
+	       "       poro-server token revoke --state=DIR --id=N\n\n"
+	       "The HTTP job server of PoroMPM (docs/service.md). Every option may also be a line\n"
+	       "'name = value' in the config file; options on the command line win over the file.\n"
+	       "--opt=VALUE and --opt VALUE are the same.\n\n"
+	       "options:\n  --config=FILE                          read options from FILE\n");
+	for (size_t i = 0; i < OPTION_COUNT; i++) {
+		char flag[64];
+		snprintf(flag, sizeof flag, "--%s=%s", OPTIONS[i].name, OPTIONS[i].arg);
+		printf("  %-38s %s\n", flag, OPTIONS[i].help);
+	}
+	printf("  %-38s %s\n  %-38s %s\n\n", "-h, --help", "this text", "--version", "print the version");
+	printf("The log (stderr): one logfmt line per request, job state change and message; with the\n"
+	       "systemd journal's priority prefix when stderr is the journal. SIGTERM or SIGINT stops the\n"
+	       "server cleanly. Exit status: 0 after a signal, 1 when it cannot start, 2 for a bad command\n"
+	       "line or configuration.\n");
 }
 
-static int set_option(struct server_config *cfg, const char *name, const char *value, const char *where)
+/* Sets option name to value; 0, or -1 with the reason in why. */
+static int set_option(struct server_config *cfg, const char *name, const char *value, char *why, size_t why_size)
 {
 	for (size_t i = 0; i < OPTION_COUNT; i++) {
 		const struct option_def *o = &OPTIONS[i];
@@ -116,7 +131,7 @@ static int set_option(struct server_config *cfg, const char *name, const char *v
 		char *field = (char *)cfg + o->offset;
 		if (o->type == OPT_TEXT) {
 			if (strlen(value) >= o->size || !value[0]) {
-				fprintf(stderr, "poro-server: %s: value of '%s' is empty or too long\n", where, name);
+				snprintf(why, why_size, "value of '%s' is empty or too long", name);
 				return -1;
 			}
 			memcpy(field, value, strlen(value) + 1);
@@ -126,8 +141,8 @@ static int set_option(struct server_config *cfg, const char *name, const char *v
 		errno = 0;
 		long long v = strtoll(value, &end, 10);
 		if (errno || end == value || *end || v < o->min || v > o->max) {
-			fprintf(stderr, "poro-server: %s: '%s' must be an integer in %lld..%lld, got '%s'\n", where, name,
-				o->min, o->max, value);
+			snprintf(why, why_size, "'%s' must be an integer in %lld..%lld, got '%s'", name, o->min, o->max,
+				 value);
 			return -1;
 		}
 		if (o->type == OPT_INT)
@@ -136,7 +151,7 @@ static int set_option(struct server_config *cfg, const char *name, const char *v
 			*(long long *)(void *)field = v;
 		return 0;
 	}
-	fprintf(stderr, "poro-server: %s: unknown option '%s'\n", where, name);
+	snprintf(why, why_size, "unknown option '%s'", name);
 	return -1;
 }
 
@@ -154,7 +169,7 @@ static int read_config(struct server_config *cfg, const char *path)
 {
 	FILE *f = fopen(path, "r");
 	if (!f) {
-		fprintf(stderr, "poro-server: cannot open config file '%s': %s\n", path, strerror(errno));
+		log_say(LOG_PRIO_ERR, "cannot open config file '%s': %s", path, strerror(errno));
 		return -1;
 	}
 	char line[8192], where[SERVER_PATH_MAX + 32];
@@ -167,45 +182,81 @@ static int read_config(struct server_config *cfg, const char *path)
 		char *eq = strchr(s, '=');
 		snprintf(where, sizeof where, "%s:%d", path, number);
 		if (!eq) {
-			fprintf(stderr, "poro-server: %s: expected 'name = value'\n", where);
+			log_say(LOG_PRIO_ERR, "%s: expected 'name = value'", where);
 			rc = -1;
 			break;
 		}
 		*eq = '\0';
-		rc = set_option(cfg, trim(s), trim(eq + 1), where);
+		char why[SERVER_MESSAGE_MAX];
+		if ((rc = set_option(cfg, trim(s), trim(eq + 1), why, sizeof why)) != 0)
+			log_say(LOG_PRIO_ERR, "%s: %s", where, why);
 	}
 	fclose(f);
 	return rc;
 }
 
-/* Config file first (wherever --config appears), then the flags over it. */
+/* A bad command line: the message, the hint; -1. */
+static int bad_usage(const char *fmt, ...) __attribute__((format(printf, 1, 2)));
+static int bad_usage(const char *fmt, ...)
+{
+	va_list ap;
+	va_start(ap, fmt);
+	fprintf(stderr, "poro-server: ");
+	vfprintf(stderr, fmt, ap);
+	va_end(ap);
+	fprintf(stderr, "\nTry 'poro-server --help' for more information.\n");
+	return -1;
+}
+
+enum { LONG_CONFIG = 256, LONG_VERSION, LONG_FIRST_OPTION }; /* OPTIONS[i] is LONG_FIRST_OPTION + i */
+
+/* getopt_long's table: every row of OPTIONS, --config, --help, --version. */
+static void long_options(struct option *out)
+{
+	size_t n = 0;
+	for (size_t i = 0; i < OPTION_COUNT; i++)
+		out[n++] = (struct option){ OPTIONS[i].name, required_argument, NULL, LONG_FIRST_OPTION + (int)i };
+	out[n++] = (struct option){ "config", required_argument, NULL, LONG_CONFIG };
+	out[n++] = (struct option){ "help", no_argument, NULL, 'h' };
+	out[n++] = (struct option){ "version", no_argument, NULL, LONG_VERSION };
+	out[n] = (struct option){ NULL, 0, NULL, 0 };
+}
+
+/* The config file first (wherever --config appears), then the options over it: two passes of
+ * getopt_long, so --opt=value, --opt value and unambiguous abbreviations all work (GNU habits).
+ * --help and --version answer at once, exit 0. */
 static int parse_args(struct server_config *cfg, int argc, char **argv)
 {
 	*cfg = CONFIG_DEFAULTS;
-	for (int i = 1; i < argc; i++)
-		if (strcmp(argv[i], "--config") == 0) {
-			if (i + 1 >= argc || read_config(cfg, argv[i + 1]) != 0)
-				return i + 1 >= argc ? (fprintf(stderr, "poro-server: --config needs a file\n"), -1) : -1;
-			i++;
+	struct option longs[OPTION_COUNT + 4];
+	long_options(longs);
+	opterr = 0; /* bad_usage says what getopt would, with the hint */
+	for (int pass = 0; pass < 2; pass++) {
+		optind = 0; /* GNU: start the scan afresh */
+		int opt;
+		while ((opt = getopt_long(argc, argv, ":h", longs, NULL)) != -1) {
+			char why[SERVER_MESSAGE_MAX];
+			if (opt == 'h') {
+				usage();
+				exit(0);
+			} else if (opt == LONG_VERSION) {
+				printf("poro-server %s\n", PORO_VERSION);
+				exit(0);
+			} else if (opt == ':') {
+				return bad_usage("option '%s' needs a value", argv[optind - 1]);
+			} else if (opt == '?') {
+				return bad_usage("unknown option '%s'", argv[optind - 1]);
+			} else if (opt == LONG_CONFIG) {
+				if (pass == 0 && read_config(cfg, optarg) != 0)
+					return -1;
+			} else if (pass == 1 && set_option(cfg, OPTIONS[opt - LONG_FIRST_OPTION].name, optarg, why,
+							   sizeof why) != 0) {
+				return bad_usage("%s", why);
+			}
 		}
-	for (int i = 1; i < argc; i++) {
-		const char *a = argv[i];
-		if (strcmp(a, "--help") == 0 || strcmp(a, "-h") == 0) {
-			usage(stdout);
-			exit(0);
-		}
-		if (strcmp(a, "--version") == 0) {
-			printf("poro-server %s\n", PORO_VERSION);
-			exit(0);
-		}
-		if (strncmp(a, "--", 2) != 0 || i + 1 >= argc) {
-			fprintf(stderr, "poro-server: unexpected argument '%s' (see --help)\n", a);
-			return -1;
-		}
-		if (strcmp(a, "--config") != 0 && set_option(cfg, a + 2, argv[i + 1], "command line") != 0)
-			return -1;
-		i++;
 	}
+	if (optind < argc)
+		return bad_usage("unexpected argument '%s'", argv[optind]);
 	return 0;
 }
 
@@ -216,20 +267,20 @@ static int open_state(struct server *srv, int *lock_fd)
 	const char *state = srv->cfg.state;
 	char msg[SERVER_MESSAGE_MAX], files[SERVER_PATH_MAX];
 	if (fs_make_dirs(state) != 0) {
-		fprintf(stderr, "poro-server: cannot create state directory '%s': %s\n", state, strerror(errno));
+		log_say(LOG_PRIO_ERR, "cannot create state directory '%s': %s", state, strerror(errno));
 		return -1;
 	}
 	if ((*lock_fd = state_dir_lock(state, msg, sizeof msg)) < 0) {
-		fprintf(stderr, "poro-server: %s\n", msg);
+		log_say(LOG_PRIO_ERR, "%s", msg);
 		return -1;
 	}
 	state_dir_restrict(state);
 	/* /healthz creates its probe file here, so files/ exists before the first upload */
 	snprintf(files, sizeof files, "%s/files", state);
 	if (fs_make_dirs(files) != 0)
-		fprintf(stderr, "poro-server: cannot create '%s': %s\n", files, strerror(errno));
+		log_say(LOG_PRIO_WARNING, "cannot create '%s': %s", files, strerror(errno));
 	if (state_dir_open_store(&srv->cfg, srv, &srv->store, msg, sizeof msg) != 0) {
-		fprintf(stderr, "poro-server: %s\n", msg);
+		log_say(LOG_PRIO_ERR, "%s", msg);
 		return -1;
 	}
 	return 0;
@@ -267,11 +318,11 @@ static void sweep_files(struct server *srv)
 {
 	struct sweep_counts n;
 	if (file_sweep_startup(srv->cfg.state, srv->store, &n) != 0) {
-		fprintf(stderr, "poro-server: cannot sweep '%s/files': %s\n", srv->cfg.state, strerror(errno));
+		log_say(LOG_PRIO_WARNING, "cannot sweep '%s/files': %s", srv->cfg.state, strerror(errno));
 		return;
 	}
-	fprintf(stderr, "poro-server: start-up sweep of '%s/files': removed temporary upload files: %lld (%lld bytes); "
-		"directories of deleted jobs: %lld (%lld bytes)\n", srv->cfg.state, n.tmp_files, n.tmp_bytes, n.job_dirs,
+	log_say(LOG_PRIO_INFO, "start-up sweep of '%s/files': removed temporary upload files: %lld (%lld bytes); "
+		"directories of deleted jobs: %lld (%lld bytes)", srv->cfg.state, n.tmp_files, n.tmp_bytes, n.job_dirs,
 		n.job_bytes);
 }
 
@@ -301,16 +352,17 @@ static int serve(struct server *srv)
 	char url[512], msg[SERVER_MESSAGE_MAX];
 	void *daemon = http_start(srv, url, sizeof url, msg, sizeof msg);
 	if (!daemon) {
-		fprintf(stderr, "poro-server: %s\n", msg);
+		log_say(LOG_PRIO_ERR, "%s", msg);
 		store_close(&srv->store);
 		close(lock_fd);
 		return 1;
 	}
 	if (write_url(srv->cfg.state, url) != 0)
-		fprintf(stderr, "poro-server: cannot write '%s/server.url': %s\n", srv->cfg.state, strerror(errno));
+		log_say(LOG_PRIO_ERR, "cannot write '%s/server.url': %s", srv->cfg.state, strerror(errno));
 	struct reaper *reaper = reaper_start(srv);
 	printf("poro-server listening on %s\n", url);
 	fflush(stdout);
+	log_say(LOG_PRIO_NOTICE, "listening on %s (version %s, state directory '%s')", url, PORO_VERSION, srv->cfg.state);
 
 	int sig = 0;
 	sigwait(&signals, &sig);
@@ -324,13 +376,14 @@ static int serve(struct server *srv)
 	http_stop(daemon);          /* waits for in-flight requests, whose writes commit first */
 	store_close(&srv->store);   /* drains the writer, checkpoints, closes */
 	close(lock_fd);             /* another server may take the state directory from here on */
-	fprintf(stderr, "poro-server: stopped on signal %d\n", sig);
+	log_say(LOG_PRIO_NOTICE, "stopped on signal %d (%s)", sig, strsignal(sig));
 	return 0;
 }
 
 int main(int argc, char **argv)
 {
 	umask(077);                 /* see the top of this file and state_dir.c */
+	log_setup();
 	signal(SIGXFSZ, SIG_IGN);
 	if (argc >= 2 && strcmp(argv[1], "token") == 0)
 		return token_command(argc, argv, &CONFIG_DEFAULTS);
@@ -344,11 +397,12 @@ int main(int argc, char **argv)
 	srv.access_log_fd = -1;
 	if (srv.cfg.access_log[0] &&
 	    (srv.access_log_fd = open(srv.cfg.access_log, O_WRONLY | O_CREAT | O_APPEND | O_CLOEXEC, 0644)) < 0) {
-		fprintf(stderr, "poro-server: cannot open --access-log '%s': %s\n", srv.cfg.access_log, strerror(errno));
+		log_say(LOG_PRIO_ERR, "cannot open --access-log '%s': %s", srv.cfg.access_log, strerror(errno));
 		return 2;
 	}
+	log_set_access_fd(srv.access_log_fd);
 	if (!srv.metrics) {
-		fprintf(stderr, "poro-server: out of memory\n");
+		log_say(LOG_PRIO_ERR, "out of memory");
 		return 1;
 	}
 	int rc = serve(&srv);

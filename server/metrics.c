@@ -1,8 +1,10 @@
 /*
  * metrics.c - counters, histograms and gauges of poro-server in Prometheus text format
  * (metrics.h). Histograms have fixed bucket bounds in seconds, chosen per quantity (commit times
- * are milliseconds, job durations hours). Worker heartbeat ages are kept for at most
- * WORKERS_MAX worker ids; the least recently seen is replaced, so the label set stays bounded.
+ * are milliseconds, job durations hours). Worker heartbeat ages are kept per worker id (the id
+ * each poro-worker sends in its claims and heartbeats, "host:pid" or its --name) and the user of
+ * its token, so workers sharing one token are series of their own; at most WORKERS_MAX of them,
+ * the least recently seen replaced first, so the label set stays bounded.
  * Job counts per state and the cost of job listings are read from the store at scrape time.
  */
 #include "metrics.h"
@@ -27,7 +29,8 @@ struct histogram {
 };
 
 struct worker_seen {
-	char id[SERVER_NAME_MAX + 1];
+	char id[SERVER_NAME_MAX + 1];     /* the worker's own id */
+	char user[SERVER_NAME_MAX + 1];   /* the user of its token */
 	long long at_ms;
 };
 
@@ -115,13 +118,13 @@ void metrics_add_retries(struct metrics *m, int n)
 	pthread_mutex_unlock(&m->lock);
 }
 
-void metrics_worker_seen(struct metrics *m, const char *worker)
+void metrics_worker_seen(struct metrics *m, const char *worker, const char *user)
 {
 	long long now = now_ms();
 	pthread_mutex_lock(&m->lock);
 	int slot = -1, oldest = 0;
 	for (int i = 0; i < m->worker_count; i++) {
-		if (strcmp(m->workers[i].id, worker) == 0)
+		if (strcmp(m->workers[i].id, worker) == 0 && strcmp(m->workers[i].user, user) == 0)
 			slot = i;
 		if (m->workers[i].at_ms < m->workers[oldest].at_ms)
 			oldest = i;
@@ -129,6 +132,7 @@ void metrics_worker_seen(struct metrics *m, const char *worker)
 	if (slot < 0)
 		slot = m->worker_count < WORKERS_MAX ? m->worker_count++ : oldest;
 	snprintf(m->workers[slot].id, sizeof m->workers[slot].id, "%s", worker);
+	snprintf(m->workers[slot].user, sizeof m->workers[slot].user, "%s", user);
 	m->workers[slot].at_ms = now;
 	pthread_mutex_unlock(&m->lock);
 }
@@ -236,6 +240,8 @@ char *metrics_render(struct metrics *m, struct store *store, size_t *size)
 	for (int i = 0; i < m->worker_count; i++) {
 		put(&t, "poro_worker_heartbeat_age_seconds{worker=\"");
 		put_label(&t, m->workers[i].id);
+		put(&t, "\",user=\"");
+		put_label(&t, m->workers[i].user);
 		put(&t, "\"} %.3f\n", 1e-3 * (double)(now - m->workers[i].at_ms));
 	}
 	put(&t, "# HELP poro_http_requests_total HTTP requests answered, by status code\n"

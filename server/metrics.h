@@ -18,8 +18,9 @@ void metrics_observe_job_duration(struct metrics *m, double seconds);
 void metrics_observe_commit(void *m, double seconds);   /* a store commit observer (store.h) */
 void metrics_add_lease_expiries(struct metrics *m, int n);
 void metrics_add_retries(struct metrics *m, int n);
-/* Records a heartbeat (or claim) of a worker id for poro_worker_heartbeat_age_seconds. */
-void metrics_worker_seen(struct metrics *m, const char *worker);
+/* Records a heartbeat (or claim) of a worker for poro_worker_heartbeat_age_seconds{worker, user}:
+ * worker is the id the worker sent, user its token's user. */
+void metrics_worker_seen(struct metrics *m, const char *worker, const char *user);
 
 /* The exposition text (malloc'ed) with job counts from the store; NULL when out of memory. */
 char *metrics_render(struct metrics *m, struct store *store, size_t *size);

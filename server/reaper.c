@@ -5,6 +5,7 @@
  * stale_attempt).
  */
 #include "reaper.h"
+#include "log.h"
 #include "metrics.h"
 #include "store.h"
 
@@ -39,7 +40,7 @@ static void *reaper_main(void *arg)
 		struct reap_counts counts;
 		struct api_error err = { 0 };
 		if (store_reap(r->srv->store, &counts, &err) != API_OK)
-			fprintf(stderr, "poro-server: reaper: %s\n", err.message);
+			log_say(LOG_PRIO_ERR, "reaper: %s", err.message);
 		api_error_release(&err);
 		metrics_add_lease_expiries(r->srv->metrics, counts.expired);
 		metrics_add_retries(r->srv->metrics, counts.retried);

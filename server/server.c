@@ -1,7 +1,7 @@
 /*
  * server.c - the small pieces every part of poro-server uses (server.h): the error table's
- * lookups and api_fail(), role names, wall-clock time in RFC 3339, and the wake-ups of blocked
- * long-polls and log followers.
+ * lookups and api_fail(), role names, wall-clock time in RFC 3339, the wake-ups of blocked
+ * long-polls and log followers, and whether any worker is live.
  */
 #include "server.h"
 
@@ -97,4 +97,17 @@ void server_wake_log_readers(struct server *srv)
 	srv->log_seq++;
 	pthread_cond_broadcast(&srv->log_cv);
 	pthread_mutex_unlock(&srv->wake_lock);
+}
+
+void server_worker_seen(struct server *srv)
+{
+	atomic_store(&srv->worker_seen_ms, now_ms());
+}
+
+enum worker_presence server_workers(struct server *srv)
+{
+	if (atomic_load(&srv->claims_waiting) > 0)
+		return WORKERS_WAITING;
+	long long seen = atomic_load(&srv->worker_seen_ms);
+	return seen > 0 && now_ms() - seen <= 1000LL * srv->cfg.lease_seconds ? WORKERS_BUSY : WORKERS_NONE;
 }

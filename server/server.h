@@ -15,6 +15,7 @@
 #include <jansson.h>
 #include <limits.h>
 #include <pthread.h>
+#include <stdatomic.h>
 
 #define SERVER_NAME_MAX 128           /* user names, job names, worker ids, hosts: bytes */
 #define SERVER_PATH_MAX 4096          /* paths built under the state directory */
@@ -45,7 +46,7 @@ struct server_config {
 	int max_backoff_seconds;      /* cap of the retry backoff min(2^(attempt-1), cap) */
 	int group_commit_max;         /* most write requests in one transaction */
 	int max_job_threads;          /* most threads a job may ask for (1..256 on the wire) */
-	char access_log[SERVER_STATE_MAX]; /* one line per answered request, or "" for none */
+	char access_log[SERVER_STATE_MAX]; /* the log's request lines go here too, or "" for none */
 	long long max_log_bytes;      /* log text kept per attempt: its first and last half, bytes */
 	long long user_max_stored_bytes; /* default per-user cap on stored bytes; 0 = unlimited */
 	int min_free_mb;              /* /healthz is degraded below this much free space on the state file system, MiB */
@@ -136,11 +137,22 @@ struct server {
 	unsigned long long claim_seq;     /* bumped with claim_cv, under wake_lock */
 	pthread_cond_t log_cv;            /* broadcast when a log chunk or a job end was committed */
 	unsigned long long log_seq;       /* bumped with log_cv, under wake_lock */
+	/* What the server hears from workers, for why a queued job waits (store_jobs.c, "waiting"): */
+	atomic_llong worker_seen_ms;      /* last claim or heartbeat of any worker, ms since the epoch; 0 = never */
+	atomic_int claims_waiting;        /* claims long-polling for work right now */
 };
 
 /* Wake-ups (server.c): after a commit that queued a job, or appended a log / ended an attempt. */
 void server_wake_claimers(struct server *srv);
 void server_wake_log_readers(struct server *srv);
+
+/* Workers: server_worker_seen() on every claim and heartbeat. server_workers() says whether a
+ * claim is waiting for work right now (an idle worker long-polls one), else whether a worker was
+ * heard from within the last --lease-seconds (a worker running jobs heartbeats at least every
+ * lease / 3), else none is live. */
+enum worker_presence { WORKERS_NONE, WORKERS_BUSY, WORKERS_WAITING };
+void server_worker_seen(struct server *srv);
+enum worker_presence server_workers(struct server *srv);
 
 /* Wall-clock time in milliseconds since the epoch, and as RFC 3339 UTC ("...T...Z") into out[32]. */
 long long now_ms(void);

@@ -9,6 +9,7 @@
  * the past; the umask keeps the future private.
  */
 #define _XOPEN_SOURCE 700
+#include "log.h"
 #include "state_dir.h"
 #include "store.h"
 
@@ -46,8 +47,7 @@ static void restrict_one(const char *path, const struct stat *st)
 		return;
 	mode_t mode = S_ISDIR(st->st_mode) ? OWNER_ONLY : st->st_mode & OWNER_ONLY;
 	if (chmod(path, mode) != 0) {
-		fprintf(stderr, "poro-server: warning: cannot make '%s' private to its owner: %s\n", path,
-			strerror(errno));
+		log_say(LOG_PRIO_WARNING, "cannot make '%s' private to its owner: %s", path, strerror(errno));
 		restrict_failures++;
 	}
 }
@@ -137,7 +137,7 @@ int state_dir_lock(const char *state, char *msg, size_t msg_size)
 	int n = snprintf(text, sizeof text, "%ld\n", (long)getpid());
 	if (ftruncate(fd, 0) != 0 || pwrite(fd, text, (size_t)n, 0) != n) {
 		/* the lock holds without the pid; only the second server's message loses it */
-		fprintf(stderr, "poro-server: warning: cannot write the pid into '%s': %s\n", path, strerror(errno));
+		log_say(LOG_PRIO_WARNING, "cannot write the pid into '%s': %s", path, strerror(errno));
 	}
 	return fd;
 }

@@ -146,12 +146,16 @@ static void run_batch(struct store *s, struct write_op *batch)
 			op->status = db_fail(c, op->err, "opening a savepoint");
 			continue;
 		}
+		int mark = store_events_mark(s);
 		op->status = op->fn(s, c, op->arg, op->err);
-		if (op->status != API_OK)
+		if (op->status != API_OK) {
 			conn_exec(c, "ROLLBACK TO op");
+			store_events_rollback(s, mark);
+		}
 		conn_exec(c, "RELEASE op");
 	}
-	if (conn_exec(c, "COMMIT") != SQLITE_OK) {
+	int committed = conn_exec(c, "COMMIT") == SQLITE_OK;
+	if (!committed) {
 		struct api_error e = { 0 };
 		db_fail(c, &e, "committing");
 		conn_exec(c, "ROLLBACK");
@@ -160,6 +164,7 @@ static void run_batch(struct store *s, struct write_op *batch)
 			if (op->status == API_OK)
 				op->status = api_fail(op->err, API_INTERNAL, "", "%s", e.message);
 	}
+	store_events_flush(s, committed);
 	if (s->observe_commit)
 		s->observe_commit(s->observe_cls, seconds_since(&t0));
 }
@@ -301,6 +306,8 @@ enum api_code store_open(struct store **out, const char *path, const struct serv
 		return api_fail(err, API_INTERNAL, "", "%s", msg);
 	}
 	enum api_code rc = migrations_apply(&s->writer, err);
+	if (rc == API_OK && store_events_watch(s, msg, sizeof msg) != 0)
+		rc = api_fail(err, API_INTERNAL, "", "%s", msg);
 	if (rc != API_OK) {
 		conn_close(&s->writer);
 		free(s);
@@ -336,6 +343,7 @@ void store_close(struct store **sp)
 	}
 	/* The last connection to close checkpoints the WAL into the database file. */
 	conn_close(&s->writer);
+	store_events_release(s);
 	pthread_mutex_destroy(&s->lock);
 	pthread_cond_destroy(&s->queue_cv);
 	pthread_cond_destroy(&s->done_cv);

@@ -112,7 +112,7 @@ static enum api_code finish_run(struct store *s, struct conn *c, void *arg, stru
 	if (rc != API_OK)
 		return rc;
 	store_after_commit(s, WAKE_LOG_READERS);
-	op->job = job_load(c, op->id, 0, err);
+	op->job = job_load(s, c, op->id, 0, err);
 	return op->job ? API_OK : API_INTERNAL;
 }
 

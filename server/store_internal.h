@@ -46,6 +46,11 @@ struct store {
 	void *observe_cls;
 
 	struct list_stats list;               /* under lock: the cost of listings (store_job_list) */
+
+	/* events rows written by the running batch, logged once it commits (store_events.c);
+	 * the writer thread's alone */
+	struct event_note *notes;
+	int note_count, note_cap, notes_lost;
 };
 
 typedef enum api_code (*write_fn)(struct store *s, struct conn *c, void *arg, struct api_error *err);
@@ -69,6 +74,16 @@ enum api_code db_fail(struct conn *c, struct api_error *err, const char *what);
 int conn_open(struct conn *c, const char *path, int readonly, char *msg, size_t msg_size);
 void conn_close(struct conn *c);
 
+/* The log line of every events row (store_events.c). watch installs, on the writer's connection,
+ * the TEMP trigger that notes each row (0, or -1 with msg set); mark is taken before a write
+ * runs and rollback drops the notes after it when the write is rolled back; flush logs the
+ * batch's notes when it committed, drops them when not; release frees them (store_close). */
+int store_events_watch(struct store *s, char *msg, size_t msg_size);
+int store_events_mark(const struct store *s);
+void store_events_rollback(struct store *s, int mark);
+void store_events_flush(struct store *s, int committed);
+void store_events_release(struct store *s);
+
 /* Migrations (migrations.c): applies every migration newer than the database's version in one
  * transaction; refuses a database newer than the binary. */
 enum api_code migrations_apply(struct conn *c, struct api_error *err);
@@ -84,10 +99,12 @@ json_t *col_json_time(sqlite3_stmt *st, int i);
 /* SELECT list of a job row for job_from_row(), joined as "FROM jobs j JOIN users u ON u.id = j.user_id". */
 #define JOB_COLUMNS "j.id, u.name, j.name, j.state, j.priority, j.threads, j.wall_time_seconds, j.attempt, " \
 	"j.created_at, j.started_at, j.finished_at, j.case_sha256, j.solver_version, j.worker_host, " \
-	"j.progress, j.message, j.cancel_requested, j.user_id "
-json_t *job_from_row(sqlite3_stmt *st);
+	"j.progress, j.message, j.cancel_requested, j.user_id, j.not_before, u.running, u.max_running "
+/* The job of a row of JOB_COLUMNS as JSON; s gives what "waiting" needs besides the row (the
+ * default cap on running jobs, whether a worker is live). */
+json_t *job_from_row(struct store *s, sqlite3_stmt *st);
 /* The job as JSON (full: with files and events), read through c; NULL with err set if missing. */
-json_t *job_load(struct conn *c, long long id, int full, struct api_error *err);
+json_t *job_load(struct store *s, struct conn *c, long long id, int full, struct api_error *err);
 /* Moves a job from one state to another: updates the job, the owner's counters and writes the
  * event row (actor, attempt, detail). The caller has checked that the job is in `from`. */
 enum api_code job_transition(struct conn *c, long long id, enum job_state from, enum job_state to, int attempt,

@@ -3,7 +3,7 @@
  * and the storage quota, get, list (index range scans, see "listing" below), cancel, counts; and
  * the helpers every job write shares: job_transition(), the one place a job changes state, which
  * also keeps the owner's queued/running counters and job_counts and writes the event row, and
- * the JSON form of a job (docs/service.md §3).
+ * the JSON form of a job (docs/service.md §3), with "waiting": why a queued job waits.
  *
  * Visibility: a user sees only its own jobs, an admin every job; another user's job is reported
  * exactly like a missing one (API_NOT_FOUND), so ids reveal nothing.
@@ -41,7 +41,50 @@ static int visible(const struct principal *who, long long owner)
 	return who->role == ROLE_ADMIN || who->user_id == owner;
 }
 
-json_t *job_from_row(sqlite3_stmt *st)
+/* Why a queued job waits, for "waiting" (null unless queued), the first that holds of: a retry
+ * after an infrastructure failure is not due yet (not_before); its user has as many running jobs
+ * as the user's cap (max_running, else --user-max-running; 0 = none); no worker is live
+ * (server_workers); a worker is waiting for work, so the job is about to be claimed (it or, first,
+ * the jobs fair share hands out before it: docs/service.md §2 "Fair share"); else every live worker
+ * is busy and the job waits behind other jobs. From the row and the server's memory alone, so a
+ * listing costs no query more. */
+static json_t *job_waiting(struct store *s, sqlite3_stmt *st)
+{
+	const char *state = col_text(st, 3);
+	if (!state || strcmp(state, "queued") != 0)
+		return json_null();
+	long long not_before = sqlite3_column_int64(st, 18), now = now_ms();
+	long long running = sqlite3_column_int64(st, 19);
+	long long cap = sqlite3_column_type(st, 20) == SQLITE_NULL ? s->cfg->user_max_running
+								   : sqlite3_column_int64(st, 20);
+	enum worker_presence workers = s->srv ? server_workers(s->srv) : WORKERS_NONE;
+	char message[SERVER_MESSAGE_MAX];
+	const char *reason;
+	if (not_before > now) {
+		char at[32];
+		format_time(not_before, at);
+		reason = "retry_backoff";
+		snprintf(message, sizeof message, "retried after an infrastructure failure, not before %s", at);
+	} else if (cap > 0 && running >= cap) {
+		reason = "user_running_cap";
+		snprintf(message, sizeof message, "its user has %lld running job%s, the user's cap on running jobs "
+			 "(max_running) is %lld", running, running == 1 ? "" : "s", cap);
+	} else if (workers == WORKERS_NONE) {
+		reason = "no_worker";
+		snprintf(message, sizeof message, "no worker has asked for work or renewed a lease in the last %d s",
+			 s->cfg->lease_seconds);
+	} else if (workers == WORKERS_WAITING) {
+		reason = "starting";
+		snprintf(message, sizeof message, "a worker is waiting for work: the job is about to be claimed");
+	} else {
+		reason = "behind_other_jobs";
+		snprintf(message, sizeof message, "every live worker is busy: it waits for a free slot behind the jobs "
+			 "that fair share hands out before it");
+	}
+	return json_pack("{s:s, s:s}", "reason", reason, "message", message);
+}
+
+json_t *job_from_row(struct store *s, sqlite3_stmt *st)
 {
 	json_t *progress = json_null();
 	const char *p = col_text(st, 14);
@@ -52,7 +95,7 @@ json_t *job_from_row(sqlite3_stmt *st)
 			progress = parsed;
 		}
 	}
-	return json_pack("{s:I, s:o, s:o, s:o, s:i, s:i, s:i, s:i, s:o, s:o, s:o, s:o, s:o, s:o, s:o, s:o, s:b}",
+	return json_pack("{s:I, s:o, s:o, s:o, s:i, s:i, s:i, s:i, s:o, s:o, s:o, s:o, s:o, s:o, s:o, s:o, s:b, s:o}",
 			 "id", (json_int_t)sqlite3_column_int64(st, 0), "user", col_json_text(st, 1),
 			 "name", col_json_text(st, 2), "state", col_json_text(st, 3),
 			 "priority", sqlite3_column_int(st, 4), "threads", sqlite3_column_int(st, 5),
@@ -61,7 +104,7 @@ json_t *job_from_row(sqlite3_stmt *st)
 			 "finished_at", col_json_time(st, 10), "case_sha256", col_json_text(st, 11),
 			 "solver_version", col_json_text(st, 12), "worker_host", col_json_text(st, 13),
 			 "progress", progress, "message", col_json_text(st, 15),
-			 "cancel_requested", sqlite3_column_int(st, 16));
+			 "cancel_requested", sqlite3_column_int(st, 16), "waiting", job_waiting(s, st));
 }
 
 static const char SQL_JOB[] = "SELECT " JOB_COLUMNS "FROM jobs j JOIN users u ON u.id = j.user_id WHERE j.id = ?1";
@@ -125,7 +168,8 @@ static enum api_code add_details(struct conn *c, long long id, json_t *job, stru
 }
 
 /* Loads a job; *owner gets its user id (for visibility checks). */
-static json_t *job_load_owner(struct conn *c, long long id, int full, long long *owner, struct api_error *err)
+static json_t *job_load_owner(struct store *s, struct conn *c, long long id, int full, long long *owner,
+			      struct api_error *err)
 {
 	sqlite3_stmt *st = conn_stmt(c, SQL_JOB);
 	if (!st) {
@@ -138,7 +182,7 @@ static json_t *job_load_owner(struct conn *c, long long id, int full, long long 
 		api_fail(err, API_NOT_FOUND, "", "no job %lld", id);
 		return NULL;
 	}
-	json_t *job = job_from_row(st);
+	json_t *job = job_from_row(s, st);
 	if (owner)
 		*owner = sqlite3_column_int64(st, 17);
 	sqlite3_reset(st);
@@ -149,9 +193,9 @@ static json_t *job_load_owner(struct conn *c, long long id, int full, long long 
 	return job;
 }
 
-json_t *job_load(struct conn *c, long long id, int full, struct api_error *err)
+json_t *job_load(struct store *s, struct conn *c, long long id, int full, struct api_error *err)
 {
-	return job_load_owner(c, id, full, NULL, err);
+	return job_load_owner(s, c, id, full, NULL, err);
 }
 
 enum api_code job_event(struct conn *c, long long id, enum job_state from, enum job_state to, int attempt,
@@ -221,7 +265,8 @@ struct submit_op {
 	int created;
 };
 
-static enum api_code existing_key(struct conn *c, struct submit_op *op, int *found, struct api_error *err)
+static enum api_code existing_key(struct store *s, struct conn *c, struct submit_op *op, int *found,
+				  struct api_error *err)
 {
 	*found = 0;
 	sqlite3_stmt *st = conn_stmt(c, "SELECT body_sha256, job_id FROM idempotency WHERE user_id = ?1 AND key = ?2");
@@ -240,7 +285,7 @@ static enum api_code existing_key(struct conn *c, struct submit_op *op, int *fou
 	if (!same)
 		return api_fail(err, API_IDEMPOTENCY_CONFLICT, "Idempotency-Key",
 				"idempotency key was used for job %lld with another request body", id);
-	op->job = job_load(c, id, 0, err);
+	op->job = job_load(s, c, id, 0, err);
 	return op->job ? API_OK : API_INTERNAL;
 }
 
@@ -283,7 +328,7 @@ static enum api_code submit_run(struct store *s, struct conn *c, void *arg, stru
 	enum api_code rc;
 	if (in->idempotency_key) {
 		int found;
-		if ((rc = existing_key(c, op, &found, err)) != API_OK || found)
+		if ((rc = existing_key(s, c, op, &found, err)) != API_OK || found)
 			return rc;
 	}
 	long long case_bytes = (long long)strlen(in->case_json), id = 0;
@@ -338,7 +383,7 @@ static enum api_code submit_run(struct store *s, struct conn *c, void *arg, stru
 		if (step != SQLITE_DONE)
 			return db_fail(c, err, "storing an idempotency key");
 	}
-	op->job = job_load(c, id, 0, err);
+	op->job = job_load(s, c, id, 0, err);
 	if (!op->job)
 		return API_INTERNAL;
 	op->created = 1;
@@ -370,7 +415,7 @@ enum api_code store_job_get(struct store *s, const struct principal *who, long l
 		return API_INTERNAL;
 	conn_exec(c, "BEGIN"); /* one snapshot for the job, its files and its events */
 	long long owner = 0;
-	*job = job_load_owner(c, id, full, &owner, err);
+	*job = job_load_owner(s, c, id, full, &owner, err);
 	store_reader_done(s, c);
 	if (*job && !visible(who, owner)) {
 		json_decref(*job);
@@ -470,7 +515,7 @@ enum api_code store_job_list(struct store *s, const struct principal *who, unsig
 			more = 1;
 			break;
 		}
-		json_array_append_new(jobs, job_from_row(cur[best].st));
+		json_array_append_new(jobs, job_from_row(s, cur[best].st));
 		last = sqlite3_column_int64(cur[best].st, 0);
 		n++;
 		cur[best].row = sqlite3_step(cur[best].st) == SQLITE_ROW;
@@ -582,7 +627,7 @@ static enum api_code cancel_run(struct store *s, struct conn *c, void *arg, stru
 	}
 	if (rc != API_OK)
 		return rc;
-	op->job = job_load(c, op->id, 0, err);
+	op->job = job_load(s, c, op->id, 0, err);
 	return op->job ? API_OK : API_INTERNAL;
 }
 

@@ -5,6 +5,8 @@
  *   poro-server token list   --state DIR
  *   poro-server token revoke --state DIR --id N
  *
+ * Options as getopt_long reads them: --state=DIR and --state DIR are the same.
+ *
  * create prints the new token and nothing else on stdout (scripts capture it); it is the only
  * place, with the answer of POST /v1/tokens, where a token is ever shown. list shows each token's
  * id, user, role, fingerprint (TOKEN_FINGERPRINT_HEX hex digits of its SHA-256), times and label.
@@ -17,6 +19,7 @@
 
 #include "digest.h"
 
+#include <getopt.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -31,35 +34,53 @@ struct token_args {
 
 static int token_usage(void)
 {
-	fprintf(stderr, "usage: poro-server token create --state DIR --user NAME --role user|worker|admin [--label TEXT]\n"
-			"       poro-server token list --state DIR\n"
-			"       poro-server token revoke --state DIR --id N\n");
+	fprintf(stderr,
+		"usage: poro-server token create --state=DIR --user=NAME --role=user|worker|admin [--label=TEXT]\n"
+		"       poro-server token list --state=DIR\n"
+		"       poro-server token revoke --state=DIR --id=N\n");
 	return 2;
 }
 
-/* Reads "--name value" pairs from argv[3]; the subcommand checks which it needs. */
+enum { ARG_STATE = 256, ARG_USER, ARG_ROLE, ARG_LABEL, ARG_ID };
+static const struct option TOKEN_OPTIONS[] = {
+	{ "state", required_argument, NULL, ARG_STATE }, { "user", required_argument, NULL, ARG_USER },
+	{ "role", required_argument, NULL, ARG_ROLE },   { "label", required_argument, NULL, ARG_LABEL },
+	{ "id", required_argument, NULL, ARG_ID },       { NULL, 0, NULL, 0 },
+};
+
+/* Reads the options after the subcommand (argv[2]) with getopt_long: --name=value or --name
+ * value; the subcommand checks which it needs. */
 static int parse_token_args(int argc, char **argv, struct token_args *a)
 {
-	for (int i = 3; i < argc; i += 2) {
-		const char *v = i + 1 < argc ? argv[i + 1] : NULL;
-		if (!v) {
-			fprintf(stderr, "poro-server: token %s: '%s' needs a value\n", argv[2], argv[i]);
+	int opt;
+	opterr = 0;
+	optind = 0;
+	/* getopt sees argv[2..]: the subcommand stands where a program's name would */
+	while ((opt = getopt_long(argc - 2, argv + 2, ":", TOKEN_OPTIONS, NULL)) != -1) {
+		switch (opt) {
+		case ARG_STATE:
+			if (strlen(optarg) >= sizeof a->cfg.state) {
+				fprintf(stderr, "poro-server: token %s: --state is too long\n", argv[2]);
+				return -1;
+			}
+			snprintf(a->cfg.state, sizeof a->cfg.state, "%s", optarg);
+			break;
+		case ARG_USER: a->user = optarg; break;
+		case ARG_ROLE: a->role = optarg; break;
+		case ARG_LABEL: a->label = optarg; break;
+		case ARG_ID: a->id = optarg; break;
+		case ':':
+			fprintf(stderr, "poro-server: token %s: '%s' needs a value\n", argv[2], argv[2 + optind - 1]);
+			return -1;
+		default:
+			fprintf(stderr, "poro-server: token %s: unknown argument '%s'\n", argv[2],
+				argv[2 + optind - 1]);
 			return -1;
 		}
-		if (strcmp(argv[i], "--state") == 0 && strlen(v) < sizeof a->cfg.state)
-			snprintf(a->cfg.state, sizeof a->cfg.state, "%s", v);
-		else if (strcmp(argv[i], "--user") == 0)
-			a->user = v;
-		else if (strcmp(argv[i], "--role") == 0)
-			a->role = v;
-		else if (strcmp(argv[i], "--label") == 0)
-			a->label = v;
-		else if (strcmp(argv[i], "--id") == 0)
-			a->id = v;
-		else {
-			fprintf(stderr, "poro-server: token %s: unknown argument '%s'\n", argv[2], argv[i]);
-			return -1;
-		}
+	}
+	if (optind < argc - 2) {
+		fprintf(stderr, "poro-server: token %s: unexpected argument '%s'\n", argv[2], argv[2 + optind]);
+		return -1;
 	}
 	return 0;
 }

@@ -72,7 +72,9 @@ void worker_claim(struct request *r)
 	struct server *srv = r->srv;
 	struct job_claim in = { .who = &r->who, .worker = worker, .host = host ? host : worker };
 	long long deadline = now_ms() + 1000 * wait;
-	metrics_worker_seen(srv->metrics, r->who.name);
+	metrics_worker_seen(srv->metrics, worker, r->who.name);
+	server_worker_seen(srv);
+	atomic_fetch_add(&srv->claims_waiting, 1);
 	for (;;) {
 		pthread_mutex_lock(&srv->wake_lock);
 		unsigned long long seq = srv->claim_seq;
@@ -98,20 +100,23 @@ void worker_claim(struct request *r)
 		}
 		wait_for_work(srv, seq, deadline);
 	}
+	atomic_fetch_sub(&srv->claims_waiting, 1);
+	server_worker_seen(srv);
 	json_decref(body);
 }
 
 void worker_heartbeat(struct request *r)
 {
-	static const char *const keys[] = { "attempt", "progress", "solver_version", NULL };
+	static const char *const keys[] = { "attempt", "progress", "solver_version", "worker", NULL };
 	json_t *body = api_body_object(r);
 	if (!body)
 		return;
 	long long attempt;
-	const char *version;
+	const char *version, *worker;
 	json_t *progress = json_object_get(body, "progress");
 	if (api_known_keys(r, body, keys) || required_int(r, body, "attempt", 1, ATTEMPT_MAX, &attempt) ||
-	    api_string_member(r, body, "solver_version", SERVER_NAME_MAX, 0, &version))
+	    api_string_member(r, body, "solver_version", SERVER_NAME_MAX, 0, &version) ||
+	    api_string_member(r, body, "worker", SERVER_NAME_MAX, 0, &worker))
 		goto done;
 	if (progress && !json_is_null(progress) && !json_is_object(progress)) {
 		reply_fail(r, API_INVALID_REQUEST, "/progress", "'progress' must be an object or null");
@@ -125,7 +130,9 @@ void worker_heartbeat(struct request *r)
 		reply_error(r, &err);
 		goto done;
 	}
-	metrics_worker_seen(r->srv->metrics, r->who.name);
+	/* a worker that sends no id (older ones) shows under its token's user */
+	metrics_worker_seen(r->srv->metrics, worker ? worker : r->who.name, r->who.name);
+	server_worker_seen(r->srv);
 	char at[32];
 	format_time(expires, at);
 	reply_json(r, 200, json_pack("{s:b, s:s}", "cancel", cancel, "lease_expires_at", at));

@@ -66,8 +66,23 @@ void sim_grid_masses(const struct sim *s, double *grid_soil, double *grid_water,
  * correction, grid-to-particle, kinematics, stress update. */
 enum sim_phase { PHASE_SHAPE, PHASE_P2G, PHASE_PREDICT, PHASE_PRESSURE_ASSEMBLY, PHASE_PRESSURE_SOLVE,
 		 PHASE_CORRECT, PHASE_G2P, PHASE_KINEMATICS, PHASE_STRESS, PHASE_COUNT };
-const char *sim_phase_name(enum sim_phase phase);
+const char *sim_phase_name(enum sim_phase phase);   /* the semi-implicit scheme's names */
+/* What the phase slot times in s's scheme; NULL for a slot the scheme does not use. */
+const char *sim_phase_name_of(const struct sim *s, enum sim_phase phase);
 double sim_phase_seconds(const struct sim *s, enum sim_phase phase);
+
+/* The nonlinear iterations of a scheme that iterates (the implicit u-p-U scheme's Newton loop):
+ * the last step's count, the run's total, and *energies (may be NULL) the last step's |delta . r|
+ * per iteration, *count of them (at most the first SIM_ITERATIONS_KEPT). Returns 0 for a scheme
+ * that takes each step in one pass (and sets the counts to 0). */
+#define SIM_ITERATIONS_KEPT 64
+int sim_iterations(const struct sim *s, int *last, long *total, const double **energies, int *count);
+
+/* The sparse direct solver's work so far, for a scheme with one (the implicit u-p-U scheme's LU):
+ * symbolic analyses, numeric factorisations, solves and the nonzeros of the last factors. Returns
+ * 0 (and zeros) for the others. */
+int sim_linear_solver_counts(const struct sim *s, long *analyses, long *factorisations, long *solves,
+			     long *factor_nonzeros);
 
 /* Value of probe i of the case at the current state (units: Pa, m). */
 double sim_probe_value(const struct sim *s, int i);
@@ -79,6 +94,8 @@ struct sim_progress {
 	double us_per_point_step;        /* wall microseconds per material-point step of this run so far */
 	int checkpoint;                  /* 1: not a progress report but the announcement that
 					    DIR/checkpoint.h5 now holds this step (checkpoint.h) */
+	int iterations_last;             /* a scheme that iterates (sim_iterations): the last step's */
+	double iterations_mean;          /* and the mean a step since the start; 0 for the others */
 };
 typedef void (*sim_progress_fn)(const struct sim_progress *p, void *user);
 

@@ -42,8 +42,10 @@ static enum poro_status write_frame(struct sim *s, struct output *o)
 {
 	struct output_frame fr = {.time = s->time, .step = s->step, .soil = &s->soil,
 				  .water = s->double_point ? &s->water : NULL};
-	if (!s->double_point)    /* single point: the soil points carry the pore pressure */
-		memcpy(s->soil.pressure, s->water.pressure, sizeof(double) * (size_t)s->soil.n);
+	/* single point: the soil points carry the pore pressure; those of dry bodies, the last ones
+	 * (sim.c), carry no water and keep 0 */
+	if (!s->double_point)
+		memcpy(s->soil.pressure, s->water.pressure, sizeof(double) * (size_t)s->water.n);
 	return output_frame_write(o, &fr, &s->err);
 }
 
@@ -69,6 +71,10 @@ static void report(struct sim *s, sim_progress_fn progress, void *user, double t
 		.us_per_point_step = steps > 0 ? 1e6 * wall / ((double)steps * points) : 0.0,
 		.checkpoint = checkpoint,
 	};
+	long total;
+	int count;
+	if (sim_iterations(s, &pr.iterations_last, &total, NULL, &count))
+		pr.iterations_mean = steps > 0 ? (double)total / (double)s->step : 0.0;
 	progress(&pr, user);
 }
 

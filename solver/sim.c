@@ -13,7 +13,11 @@
  * dropped by round-off), while the load and the free surface took the side where the case puts it
  * (docs/numerics.md, "Columns whose top cuts a cell").
  * Double point seeds one water point on every soil point (000 §5.1: "640 material points in total
- * for both water and soil").
+ * for both water and soil") of a saturated body; a dry body ("saturated": false) gets none, and in
+ * single point its points carry no water. The saturated bodies are seeded first, so the points that
+ * carry water are the first ones: the single-point water set rides on them alone, and the
+ * double-point one copies them (docs/numerics.md, "Dry bodies"). A case whose bodies are all
+ * saturated is seeded in its bodies' order, as before.
  */
 #include <math.h>
 #include <stdlib.h>
@@ -102,39 +106,53 @@ static int seed_in_body(const struct case_body *b, double d, double h, double *x
 	return 1;
 }
 
-/* Visits every seed point: fills p when it is not NULL; returns the count. */
-static idx_t seed_points(const struct sim *s, struct particles *p)
+/* Visits every seed point of body b, points count, count + 1, ... of p: fills p when it is not
+ * NULL; returns the new count. A point inside an earlier body of the case belongs to that one. */
+static idx_t seed_body(const struct sim *s, int b, struct particles *p, idx_t count)
 {
 	const struct case_spec *c = s->spec;
 	const struct grid *g = &s->grid;
-	idx_t count = 0;
-	for (int b = 0; b < c->body_count; b++) {
-		const struct case_body *body = &c->bodies[b];
-		const int ppc = body->particles_per_cell;
-		const double d = g->h / ppc;
-		for (idx_t cj = 0; cj < g->cells[1]; cj++)
-			for (idx_t ci = 0; ci < g->cells[0]; ci++)
-				for (int sj = 0; sj < ppc; sj++)
-					for (int si = 0; si < ppc; si++) {
-						double x = g->origin[0] + ci * g->h + (si + 0.5) * d;
-						double y = g->origin[1] + cj * g->h + (sj + 0.5) * d;
-						double wx = d, wy = d;
-						if (!seed_in_body(body, d, g->h, &x, &y, &wx, &wy))
-							continue;
-						int taken = 0;
-						for (int e = 0; e < b && !taken; e++)
-							taken = inside_body(&c->bodies[e], x, y, g->h);
-						if (taken)
-							continue;
-						if (p) {
-							p->x[2 * count] = p->x0[2 * count] = x;
-							p->x[2 * count + 1] = p->x0[2 * count + 1] = y;
-							p->volume[count] = p->volume0[count] = wx * wy;
-							p->body[count] = b;
-						}
-						count++;
+	const struct case_body *body = &c->bodies[b];
+	const int ppc = body->particles_per_cell;
+	const double d = g->h / ppc;
+	for (idx_t cj = 0; cj < g->cells[1]; cj++)
+		for (idx_t ci = 0; ci < g->cells[0]; ci++)
+			for (int sj = 0; sj < ppc; sj++)
+				for (int si = 0; si < ppc; si++) {
+					double x = g->origin[0] + ci * g->h + (si + 0.5) * d;
+					double y = g->origin[1] + cj * g->h + (sj + 0.5) * d;
+					double wx = d, wy = d;
+					if (!seed_in_body(body, d, g->h, &x, &y, &wx, &wy))
+						continue;
+					int taken = 0;
+					for (int e = 0; e < b && !taken; e++)
+						taken = inside_body(&c->bodies[e], x, y, g->h);
+					if (taken)
+						continue;
+					if (p) {
+						p->x[2 * count] = p->x0[2 * count] = x;
+						p->x[2 * count + 1] = p->x0[2 * count + 1] = y;
+						p->volume[count] = p->volume0[count] = wx * wy;
+						p->body[count] = b;
 					}
-	}
+					count++;
+				}
+	return count;
+}
+
+/* Visits every seed point, the saturated bodies' first (file comment): fills p when it is not NULL;
+ * returns the count, and in *saturated how many of them carry water. */
+static idx_t seed_points(const struct sim *s, struct particles *p, idx_t *saturated)
+{
+	const struct case_spec *c = s->spec;
+	idx_t count = 0;
+	for (int b = 0; b < c->body_count; b++)
+		if (c->bodies[b].saturated)
+			count = seed_body(s, b, p, count);
+	*saturated = count;
+	for (int b = 0; b < c->body_count; b++)
+		if (!c->bodies[b].saturated)
+			count = seed_body(s, b, p, count);
 	return count;
 }
 
@@ -153,29 +171,35 @@ static void init_soil_state(struct sim *s)
 	}
 }
 
-static enum poro_status init_water(struct sim *s)
+/* The water of the first n soil points, those of the saturated bodies (seed_points). */
+static enum poro_status init_water(struct sim *s, idx_t n)
 {
 	struct particles *p = &s->soil, *w = &s->water;
 	if (!s->double_point) {
 		enum poro_status st = particles_init_alias(w, p, &s->err);
 		if (st)
 			return st;
+		w->n = n;   /* rides on the first n soil points; a dry body's points carry no water */
 	} else {
-		enum poro_status st = particles_init(w, p->n, 0, &s->err);
+		enum poro_status st = particles_init(w, n, 0, &s->err);
 		if (st)
 			return st;
-		memcpy(w->x, p->x, sizeof(double) * 2 * (size_t)p->n);
-		memcpy(w->x0, p->x0, sizeof(double) * 2 * (size_t)p->n);
-		memcpy(w->volume, p->volume, sizeof(double) * (size_t)p->n);
-		memcpy(w->volume0, p->volume0, sizeof(double) * (size_t)p->n);
-		memcpy(w->porosity, p->porosity, sizeof(double) * (size_t)p->n);
-		memcpy(w->porosity0, p->porosity0, sizeof(double) * (size_t)p->n);
-		memcpy(w->conductivity, p->conductivity, sizeof(double) * (size_t)p->n);
-		memcpy(w->body, p->body, sizeof(int) * (size_t)p->n);
+		memcpy(w->x, p->x, sizeof(double) * 2 * (size_t)n);
+		memcpy(w->x0, p->x0, sizeof(double) * 2 * (size_t)n);
+		memcpy(w->volume, p->volume, sizeof(double) * (size_t)n);
+		memcpy(w->volume0, p->volume0, sizeof(double) * (size_t)n);
+		memcpy(w->porosity, p->porosity, sizeof(double) * (size_t)n);
+		memcpy(w->porosity0, p->porosity0, sizeof(double) * (size_t)n);
+		memcpy(w->conductivity, p->conductivity, sizeof(double) * (size_t)n);
+		memcpy(w->body, p->body, sizeof(int) * (size_t)n);
 	}
 	w->support = p->support;
-	for (idx_t q = 0; q < w->n; q++)
+	for (idx_t q = 0; q < w->n; q++) {
 		w->mass[q] = w->porosity0[q] * s->rho_w * w->volume0[q];   /* Eq. 37 */
+		/* the case's is physical (compression positive); the solver's tension positive */
+		const double p0 = s->spec->bodies[w->body[q]].initial_pore_pressure;
+		w->pressure[q] = p0 != 0.0 ? -p0 : 0.0;
+	}
 	return PORO_OK;
 }
 
@@ -209,15 +233,17 @@ static enum poro_status build(struct sim *s)
 		return poro_error_set(&s->err, PORO_ENOMEM, "cannot allocate materials");
 	for (int m = 0; m < c->material_count; m++)
 		material_init(&s->materials[m], &c->materials[m]);
-	idx_t n = seed_points(s, NULL);
+	idx_t saturated;
+	idx_t n = seed_points(s, NULL, &saturated);
 	if (n == 0)
 		return poro_error_set(&s->err, PORO_EINVAL, "/bodies: no material point falls inside any body");
 	if ((st = particles_init(&s->soil, n, 1, &s->err)))
 		return st;
-	seed_points(s, &s->soil);
+	seed_points(s, &s->soil, &saturated);
+	s->saturated_soil = saturated;
 	s->soil.support = shape_support(c->formulation.shape);
 	init_soil_state(s);
-	if ((st = init_water(s)) || (st = allocate_scratch(s)))
+	if ((st = init_water(s, saturated)) || (st = allocate_scratch(s)))
 		return st;
 	/* the parallel scatters' order (point_blocks.h); single-point water uses the soil's */
 	if ((st = particles_add_blocks(&s->soil, &s->grid, &s->err)) ||
@@ -319,10 +345,28 @@ double sim_clock(void)
 
 const char *sim_phase_name(enum sim_phase phase)
 {
-	static const char *const names[PHASE_COUNT] = {
-		"shape functions", "particle-to-grid", "predictors", "pressure assembly",
-		"pressure factor+solve", "correction", "grid-to-particle", "kinematics", "stress update"};
-	return phase < PHASE_COUNT ? names[phase] : "unknown";
+	return phase < PHASE_COUNT ? semi_implicit_scheme.phase_names[phase] : "unknown";
+}
+
+const char *sim_phase_name_of(const struct sim *s, enum sim_phase phase)
+{
+	return phase < PHASE_COUNT ? s->scheme->phase_names[phase] : NULL;
+}
+
+int sim_iterations(const struct sim *s, int *last, long *total, const double **energies, int *count)
+{
+	*last = 0, *total = 0, *count = 0;
+	if (energies)
+		*energies = NULL;
+	return s->scheme->iterations ? s->scheme->iterations(s, last, total, energies, count) : 0;
+}
+
+int sim_linear_solver_counts(const struct sim *s, long *analyses, long *factorisations, long *solves,
+			     long *factor_nonzeros)
+{
+	*analyses = *factorisations = *solves = *factor_nonzeros = 0;
+	return s->scheme->solver_counts ? s->scheme->solver_counts(s, analyses, factorisations, solves, factor_nonzeros)
+					: 0;
 }
 
 double sim_phase_seconds(const struct sim *s, enum sim_phase phase)

@@ -10,6 +10,7 @@
 
 #include "grid.h"
 #include "material.h"
+#include "permeability.h"
 #include "poro.h"
 #include "stable_dt.h"
 
@@ -21,16 +22,14 @@
 			return st_;                     \
 	} while (0)
 
-/* Standard gravity in the drag term n^2 rho_w g / k (000 Eq. 15): hydraulic conductivity is
- * defined with it, so it stays 9.81 m/s^2 even when a case switches the body force off. */
-#define CONDUCTIVITY_GRAVITY 9.81
-
 struct sim {
 	const struct case_spec *spec;
 	struct grid grid;
 	struct grid_fields f;
 	struct particles soil, water;
 	int double_point;
+	idx_t saturated_soil;         /* the first this many soil points belong to saturated bodies, the
+					 rest to dry ones ("saturated": false; sim.c seeds them so) */
 	struct material *materials;   /* [case material_count] */
 	const struct scheme *scheme;  /* formulation.scheme's step (scheme.h) */
 	void *scheme_state;           /* the scheme's own state, which its create allocates */

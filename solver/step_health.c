@@ -46,8 +46,7 @@ double step_health_load_strain(const struct case_spec *c, int *body)
 	const double g = hypot(c->gravity.acceleration[0], c->gravity.acceleration[1]);
 	for (int i = 0; i < c->body_count; i++) {
 		const struct case_body *b = &c->bodies[i];
-		const double buoyant = (1.0 - b->porosity) * (c->materials[b->material].density - c->fluid.density);
-		double stress = fabs(buoyant) * g * (b->max[1] - b->min[1]);
+		double stress = fabs(stable_dt_effective_density(c, i)) * g * (b->max[1] - b->min[1]);
 		for (int l = 0; l < c->load_count; l++)
 			if (c->loads[l].body == i)
 				stress += hypot(c->loads[l].traction[0], c->loads[l].traction[1]) *
@@ -62,7 +61,15 @@ double step_health_load_strain(const struct case_spec *c, int *body)
 void step_health_explain(struct sim *s)
 {
 	const struct stable_dt *e = &s->stable;
-	if (e->body >= 0) {
+	if (e->body >= 0 && e->scheme == SCHEME_EXPLICIT) {
+		char bound[STABLE_DT_DESCRIPTION_SIZE];
+		stable_dt_describe(e, s->spec, bound, sizeof bound);
+		const double ratio = s->dt / e->cfl;
+		poro_error_append(&s->err, "likely cause: %s: dt = %.6g s is %.3g of %s",
+				  ratio > STEP_HEALTH_EXPLICIT_DT_SUSPECT ? "a time step near or above the stability limit, "
+				  "take a smaller dt" : "not the time step, which is inside the stability limit",
+				  s->dt, ratio, bound);
+	} else if (e->body >= 0) {
 		const double ratio = s->dt / e->cfl;
 		poro_error_append(&s->err, "likely cause: %s: dt = %.6g s is %.3g times the soil skeleton's CFL step "
 				  "h / c_p = %.6g s (c_p = %.6g m/s in body '%s'); the Terzaghi column's measured limit "

@@ -20,10 +20,12 @@
 /* dt / (h / c_p) above which a failed step names the time step as its likely cause: the lowest
  * limit measured on the Terzaghi column is 0.87 h / c_p (drag in the correction, k = 1e-9 m/s). */
 #define STEP_HEALTH_DT_SUSPECT 0.8
+/* The explicit scheme's: dt over its critical step (stable_dt.h) above which the time step is named. */
+#define STEP_HEALTH_EXPLICIT_DT_SUSPECT 0.8
 
 /* The largest elastic strain the case's loads and gravity alone give a body: (the peak traction on
- * it + its buoyant weight over its height) / its constrained modulus; *body its index (-1: none).
- * An estimate from the parameters alone, for naming a material too soft for its load. */
+ * it + its effective weight, buoyant or dry, over its height) / its constrained modulus; *body its
+ * index (-1: none). An estimate from the parameters alone, for naming a material too soft for its load. */
 double step_health_load_strain(const struct case_spec *c, int *body);
 
 /* Appends the likely cause to s->err after a failed step. */

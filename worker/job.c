@@ -186,8 +186,8 @@ static enum send_result send_heartbeat(struct job *j)
 		progress = json_pack("{s:I, s:f, s:f, s:f}", "step", (json_int_t)g.step, "time", g.time,
 				     "us_per_mp_step", g.us_per_mp_step, "fraction",
 				     g.steps_total > 0 ? (double)g.step / (double)g.steps_total : 0.0);
-	json_t *body = json_pack("{s:i, s:o, s:s}", "attempt", j->attempt, "progress", progress, "solver_version",
-				 worker_opt.solver_version);
+	json_t *body = json_pack("{s:i, s:o, s:s, s:s}", "attempt", j->attempt, "progress", progress, "solver_version",
+				 worker_opt.solver_version, "worker", worker_opt.name);
 	char path[128];
 	snprintf(path, sizeof path, "/v1/worker/jobs/%lld/heartbeat", j->id);
 	struct http_response r;

@@ -2,7 +2,9 @@
  * job_files.c - checkpoint download, snapshots, uploads and directory removal, see job_files.h.
  * Snapshots exist because result.h5 is written in place by the solver and checkpoint.h5 is
  * replaced by rename: hashing and uploading a private copy keeps the checksum and the bytes sent
- * in agreement.
+ * in agreement. A copy of result.h5 is also what users download from a running job (poro fetch),
+ * so it is taken while the solver is not writing the file: then it holds the file as a killed run
+ * would leave it, every frame flushed before the copy readable (solver/output/output.c).
  */
 #define _XOPEN_SOURCE 700
 #include "job_files.h"
@@ -11,7 +13,16 @@
 #include <ftw.h>
 #include <stdio.h>
 #include <string.h>
+#include <sys/stat.h>
+#include <time.h>
 #include <unistd.h>
+
+/* A snapshot of a file written in place is taken only while the file stands still: its size and
+ * modification time the same before and after the copy, and the modification time at least
+ * SNAPSHOT_QUIET_SECONDS old when the copy starts (file times come from a coarse clock, so a write
+ * within the same tick as the last one would not move them). At most SNAPSHOT_TRIES tries. */
+#define SNAPSHOT_QUIET_SECONDS 0.1
+#define SNAPSHOT_TRIES 4
 
 /* GET one file of the job into dest; 0 ok, 1 retry, -1 refused, 2 not on the server. */
 static int fetch_one(struct http_client *c, long long id, int attempt, const char *name, const char *dest,
@@ -51,17 +62,14 @@ int job_files_fetch_resume(struct http_client *c, long long id, int attempt, con
 	return rc == 2 ? 0 : rc;
 }
 
-int job_files_snapshot(const char *src, const char *dst, char sha256[DIGEST_HEX_SIZE], long long *size)
+/* Copies the open file in to dst once, hashing it; 0, or -1 with errno. */
+static int copy_once(FILE *in, const char *dst, char sha256[DIGEST_HEX_SIZE], long long *size)
 {
 	*size = 0;
-	FILE *in = fopen(src, "rb");
-	if (!in)
-		return -1;
 	FILE *out = fopen(dst, "wb");
 	struct digest *d = digest_create();
 	if (!out || !d) {
 		int e = out ? ENOMEM : errno;
-		fclose(in);
 		if (out)
 			fclose(out);
 		digest_destroy(&d);
@@ -81,7 +89,6 @@ int job_files_snapshot(const char *src, const char *dst, char sha256[DIGEST_HEX_
 	}
 	failed |= ferror(in);
 	int e = errno;
-	fclose(in);
 	failed |= fclose(out) != 0;
 	digest_final_hex(d, sha256);
 	digest_destroy(&d);
@@ -91,6 +98,55 @@ int job_files_snapshot(const char *src, const char *dst, char sha256[DIGEST_HEX_
 		return -1;
 	}
 	return 0;
+}
+
+static int same_version(const struct stat *a, const struct stat *b)
+{
+	return a->st_size == b->st_size && a->st_mtim.tv_sec == b->st_mtim.tv_sec &&
+	       a->st_mtim.tv_nsec == b->st_mtim.tv_nsec;
+}
+
+static double wall_seconds(void)
+{
+	struct timespec ts;
+	clock_gettime(CLOCK_REALTIME, &ts);
+	return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+int job_files_snapshot(const char *src, const char *dst, char sha256[DIGEST_HEX_SIZE], long long *size)
+{
+	*size = 0;
+	for (int tries = 1;; tries++) {
+		FILE *in = fopen(src, "rb");
+		struct stat before, after;
+		if (!in)
+			return -1;
+		if (fstat(fileno(in), &before) < 0) {
+			int e = errno;
+			fclose(in);
+			errno = e;
+			return -1;
+		}
+		double age = wall_seconds() - ((double)before.st_mtim.tv_sec + 1e-9 * (double)before.st_mtim.tv_nsec);
+		if (age >= 0 && age < SNAPSHOT_QUIET_SECONDS && tries < SNAPSHOT_TRIES) {
+			/* just written: a write still going on might not move the coarse file time */
+			fclose(in);
+			double wait = SNAPSHOT_QUIET_SECONDS - age;
+			struct timespec ts = { 0, (long)(wait * 1e9) };
+			nanosleep(&ts, NULL);
+			continue;
+		}
+		int rc = copy_once(in, dst, sha256, size);
+		int e = errno, stable = rc == 0 && fstat(fileno(in), &after) == 0 && same_version(&before, &after);
+		fclose(in);
+		if (rc < 0) {
+			errno = e;
+			return -1;
+		}
+		/* a file that never stood still: the last copy, as good as any copy taken without looking */
+		if (stable || tries >= SNAPSHOT_TRIES)
+			return 0;
+	}
 }
 
 long job_files_upload(struct http_client *c, long long id, int attempt, const char *name, const char *path,

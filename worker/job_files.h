@@ -17,8 +17,10 @@
 int job_files_fetch_resume(struct http_client *c, long long id, int attempt, const char *out_dir,
 			   const char *want_sha256, char *err, size_t err_size);
 
-/* Copies src to dst (replaced), computing the copy's SHA-256 and size in bytes. 0, or -1 with errno
- * (ENOENT when src does not exist). */
+/* Copies src to dst (replaced), computing the copy's SHA-256 and size in bytes, at a moment when
+ * src is not being written (its size and modification time unchanged across the copy, and not
+ * modified within the last 0.1 s; a file that keeps changing gets its fourth copy as it is).
+ * Blocks for about 0.1 s after a fresh write. 0, or -1 with errno (ENOENT when src does not exist). */
 int job_files_snapshot(const char *src, const char *dst, char sha256[DIGEST_HEX_SIZE], long long *size);
 
 /* PUT /v1/worker/jobs/{id}/files/{name}?attempt=A from path with its SHA-256. Returns r->status. */

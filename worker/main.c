@@ -4,7 +4,11 @@
  *   poro-worker --server URL --token-file FILE [--slots N (1)] [--threads N (online CPUs)]
  *               [--work DIR (./var/work)] [--solver PATH] [--memory-limit-mb N]
  *               [--checkpoint-wall SECONDS (60)] [--lease-renew SECONDS] [--name NAME]
- *               [--keep-work yes|no (no)]
+ *               [--keep-work yes|no (no)] [--help] [--version]
+ *
+ * Options are parsed by getopt_long, so GNU habits hold: --opt=value or --opt value, unambiguous
+ * abbreviations, "--" ends the options. --help prints the help text on stdout and exits 0;
+ * a bad command line says what is wrong and exits 2.
  *
  * The token comes from --token-file, else PORO_TOKEN, else the config file read by the CLI; the
  * URL from --server, else PORO_SERVER. --token TOKEN still works but puts the token in every
@@ -28,6 +32,7 @@
  */
 #define _GNU_SOURCE
 #include <errno.h>
+#include <getopt.h>
 #include <limits.h>
 #include <pthread.h>
 #include <signal.h>
@@ -88,12 +93,77 @@ void worker_sleep(double seconds, int wake_on_drain)
 #define THREADS_MAX 4096
 #define MEMORY_DEFAULT (-1L)     /* memory_limit_mb before the default is computed */
 
-static int usage(void)
+/* The options, in the order --help lists them: getopt_long's table and the help text. */
+enum {
+	OPT_SERVER = 256,
+	OPT_TOKEN,
+	OPT_TOKEN_FILE,
+	OPT_SLOTS,
+	OPT_THREADS,
+	OPT_WORK,
+	OPT_SOLVER,
+	OPT_MEMORY,
+	OPT_CHECKPOINT_WALL,
+	OPT_LEASE_RENEW,
+	OPT_NAME,
+	OPT_KEEP_WORK,
+	OPT_VERSION
+};
+static const struct option OPTIONS[] = {
+	{ "server", required_argument, NULL, OPT_SERVER },
+	{ "token-file", required_argument, NULL, OPT_TOKEN_FILE },
+	{ "token", required_argument, NULL, OPT_TOKEN },
+	{ "slots", required_argument, NULL, OPT_SLOTS },
+	{ "threads", required_argument, NULL, OPT_THREADS },
+	{ "work", required_argument, NULL, OPT_WORK },
+	{ "solver", required_argument, NULL, OPT_SOLVER },
+	{ "memory-limit-mb", required_argument, NULL, OPT_MEMORY },
+	{ "checkpoint-wall", required_argument, NULL, OPT_CHECKPOINT_WALL },
+	{ "lease-renew", required_argument, NULL, OPT_LEASE_RENEW },
+	{ "name", required_argument, NULL, OPT_NAME },
+	{ "keep-work", required_argument, NULL, OPT_KEEP_WORK },
+	{ "help", no_argument, NULL, 'h' },
+	{ "version", no_argument, NULL, OPT_VERSION },
+	{ NULL, 0, NULL, 0 },
+};
+
+static void help(void)
 {
-	fprintf(stderr, "usage: poro-worker --server URL --token-file FILE [--slots N] [--threads N] [--work DIR]\n"
-			"                   [--solver PATH] [--memory-limit-mb N] [--checkpoint-wall SECONDS]\n"
-			"                   [--lease-renew SECONDS] [--name NAME] [--keep-work yes|no]\n"
-			"the token may also come from PORO_TOKEN, the URL from PORO_SERVER\n");
+	printf("usage: poro-worker --server=URL --token-file=FILE [OPTION...]\n\n"
+	       "Claims PoroMPM jobs from poro-server over HTTP, runs each with poro-solve in a directory of\n"
+	       "its own and sends its log, progress, files and outcome back (docs/service.md).\n\n"
+	       "options (--opt=VALUE or --opt VALUE):\n"
+	       "  --server=URL             the server (default: $PORO_SERVER, else the poro CLI's config file)\n"
+	       "  --token-file=FILE        the worker token, first line of FILE, which must be private to its\n"
+	       "                           owner (chmod 600); default: $PORO_TOKEN, else the config file\n"
+	       "  --token=TOKEN            the token itself: shown to every user in the process list; avoid\n"
+	       "  --slots=N                jobs run at once (default 1)\n"
+	       "  --threads=N              threads of the whole worker, shared among the slots (default: online CPUs)\n"
+	       "  --work=DIR               job directories go under DIR (default ./var/work)\n"
+	       "  --solver=PATH            poro-solve to run (default: the one beside this program, else PATH)\n"
+	       "  --memory-limit-mb=N      address space of one solver, MB; 0 = none (default: 3/4 of physical\n"
+	       "                           memory divided by the slots)\n"
+	       "  --checkpoint-wall=S      a checkpoint every S seconds of wall time; 0 = none (default 60)\n"
+	       "  --lease-renew=S          heartbeat every S seconds (default: a third of the lease, at most 1 s)\n"
+	       "  --name=NAME              the worker's id in claims, heartbeats and metrics (default HOST:PID)\n"
+	       "  --keep-work=yes|no       keep each job's directory after the job (default no)\n"
+	       "  -h, --help               this text\n"
+	       "  --version                print the version\n\n"
+	       "SIGTERM or SIGINT drains (no new jobs; running ones finish); a second one stops the solvers and\n"
+	       "hands their jobs back. Exit status: 0 after a drain, 1 when the server refused the token,\n"
+	       "2 for a bad command line.\n");
+}
+
+/* A bad command line: the message, the hint, status 2. */
+static int bad_usage(const char *fmt, ...) __attribute__((format(printf, 1, 2)));
+static int bad_usage(const char *fmt, ...)
+{
+	va_list ap;
+	va_start(ap, fmt);
+	fprintf(stderr, "poro-worker: ");
+	vfprintf(stderr, fmt, ap);
+	va_end(ap);
+	fprintf(stderr, "\nTry 'poro-worker --help' for more information.\n");
 	return 2;
 }
 
@@ -228,51 +298,63 @@ static void probe_solver(void)
 	pclose(p);
 }
 
+/* An integer option's value in lo..hi into *out: 0, or 2 after saying what is wrong. */
+static int int_option(const char *name, const char *value, long lo, long hi, long *out)
+{
+	if (parse_long(value, lo, hi, out) == 0)
+		return 0;
+	return bad_usage("--%s must be an integer in %ld..%ld, got '%s'", name, lo, hi, value);
+}
+
 static int parse_flags(int argc, char **argv)
 {
 	const char *solver = NULL, *work = "var/work", *name = NULL, *token_file = NULL;
 	long v, budget = 0;
+	int rc = 0, opt, index = 0;
 	worker_opt.slots = 1;
 	worker_opt.checkpoint_wall = 60;
 	worker_opt.memory_limit_mb = MEMORY_DEFAULT;
-	for (int i = 1; i < argc; i++) {
-		const char *a = argv[i];
-		char *val = i + 1 < argc ? argv[i + 1] : NULL;
-		if (!val)
-			return usage();
-		i++;
-		if (!strcmp(a, "--server")) {
-			snprintf(worker_opt.server, sizeof worker_opt.server, "%s", val);
-		} else if (!strcmp(a, "--token")) {
-			snprintf(worker_opt.token, sizeof worker_opt.token, "%s", val);
-			memset(val, 'x', strlen(val)); /* out of /proc/PID/cmdline from now on */
+	opterr = 0; /* getopt's own messages lack the hint; bad_usage says it all */
+	while (rc == 0 && (opt = getopt_long(argc, argv, ":h", OPTIONS, &index)) != -1) {
+		const char *o = OPTIONS[index].name;
+		switch (opt) {
+		case OPT_SERVER: snprintf(worker_opt.server, sizeof worker_opt.server, "%s", optarg); break;
+		case OPT_TOKEN:
+			snprintf(worker_opt.token, sizeof worker_opt.token, "%s", optarg);
+			memset(optarg, 'x', strlen(optarg)); /* out of /proc/PID/cmdline from now on */
 			fprintf(stderr, "poro-worker: warning: --token shows the token to every user of this machine "
 					"in the process list; use --token-file FILE or PORO_TOKEN\n");
-		} else if (!strcmp(a, "--token-file"))
-			token_file = val;
-		else if (!strcmp(a, "--slots") && !parse_long(val, 1, 1024, &v))
-			worker_opt.slots = (int)v;
-		else if (!strcmp(a, "--threads") && !parse_long(val, 1, THREADS_MAX, &v))
-			budget = v;
-		else if (!strcmp(a, "--work"))
-			work = val;
-		else if (!strcmp(a, "--solver"))
-			solver = val;
-		else if (!strcmp(a, "--memory-limit-mb") && !parse_long(val, 0, 1L << 30, &v))
-			worker_opt.memory_limit_mb = v;
-		else if (!strcmp(a, "--checkpoint-wall") && !parse_long(val, 0, 1L << 30, &v))
-			worker_opt.checkpoint_wall = v;
-		else if (!strcmp(a, "--lease-renew") && !parse_long(val, 1, 86400, &v))
-			worker_opt.lease_renew = (double)v;
-		else if (!strcmp(a, "--name"))
-			name = val;
-		else if (!strcmp(a, "--keep-work") && (!strcmp(val, "yes") || !strcmp(val, "no")))
-			worker_opt.keep_work = !strcmp(val, "yes");
-		else {
-			fprintf(stderr, "poro-worker: bad option '%s %s'\n", a, val);
-			return usage();
+			break;
+		case OPT_TOKEN_FILE: token_file = optarg; break;
+		case OPT_SLOTS:
+			if ((rc = int_option(o, optarg, 1, 1024, &v)) == 0)
+				worker_opt.slots = (int)v;
+			break;
+		case OPT_THREADS: rc = int_option(o, optarg, 1, THREADS_MAX, &budget); break;
+		case OPT_WORK: work = optarg; break;
+		case OPT_SOLVER: solver = optarg; break;
+		case OPT_MEMORY: rc = int_option(o, optarg, 0, 1L << 30, &worker_opt.memory_limit_mb); break;
+		case OPT_CHECKPOINT_WALL: rc = int_option(o, optarg, 0, 1L << 30, &worker_opt.checkpoint_wall); break;
+		case OPT_LEASE_RENEW:
+			if ((rc = int_option(o, optarg, 1, 86400, &v)) == 0)
+				worker_opt.lease_renew = (double)v;
+			break;
+		case OPT_NAME: name = optarg; break;
+		case OPT_KEEP_WORK:
+			if (strcmp(optarg, "yes") && strcmp(optarg, "no"))
+				rc = bad_usage("--keep-work must be yes or no, got '%s'", optarg);
+			worker_opt.keep_work = !strcmp(optarg, "yes");
+			break;
+		case 'h': help(); exit(0);
+		case OPT_VERSION: printf("poro-worker %s\n", PORO_VERSION); exit(0);
+		case ':': rc = bad_usage("option '%s' needs a value", argv[optind - 1]); break;
+		default: rc = bad_usage("unknown option '%s'", argv[optind - 1]); break;
 		}
 	}
+	if (rc)
+		return rc;
+	if (optind < argc)
+		return bad_usage("unexpected argument '%s'", argv[optind]);
 	if (token_file && worker_opt.token[0]) {
 		fprintf(stderr, "poro-worker: give either --token or --token-file, not both\n");
 		return 2;

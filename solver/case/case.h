@@ -26,7 +26,9 @@
  * Each sits orders of magnitude above the largest case in tests/cases/ and near or beyond what a
  * run could hold in memory, so it refuses only cases that could not run anyway. */
 #define CASE_NAME_MAX 64                 /* bytes of a name with its NUL: names are 1 to 63 characters */
-#define CASE_TITLE_MAX 255               /* bytes of the title */
+#define CASE_TITLE_MAX 255               /* characters (Unicode code points) of the title, as JSON
+					    Schema's maxLength counts them */
+#define CASE_TITLE_SIZE (4 * CASE_TITLE_MAX + 1) /* bytes that hold such a title in UTF-8, with its NUL */
 #define CASE_MATERIALS_MAX 1000
 #define CASE_BODIES_MAX 1000
 #define CASE_LOADS_MAX 1000
@@ -50,7 +52,10 @@
  * case_spec.warnings (element_case.warnings), at most this many bytes with the NUL. */
 #define CASE_WARNINGS_SIZE 2048
 
-enum case_scheme { SCHEME_SEMI_IMPLICIT };
+/* The time-integration schemes (solver/schemes/): paper 000's semi-implicit fractional step,
+ * paper 002's explicit single-point v-w scheme with compressible pore fluid, and paper 001's fully
+ * implicit u-p-U scheme (Newmark, modified Newton-Raphson). */
+enum case_scheme { SCHEME_SEMI_IMPLICIT, SCHEME_EXPLICIT, SCHEME_IMPLICIT_UPU };
 enum case_phases { PHASES_DOUBLE_POINT, PHASES_SINGLE_POINT };
 enum case_shape { SHAPE_LINEAR, SHAPE_QUADRATIC_BSPLINE, SHAPE_CUBIC_BSPLINE, SHAPE_GIMP };
 /* The matrix of the pressure solve: the Laplacian of 000 Eq. 61, or the projection G^T M^-1 G
@@ -64,12 +69,29 @@ enum free_surface_condition { FREE_SURFACE_NODES, FREE_SURFACE_INTERPOLATED, FRE
 enum position_update { POSITION_UPDATE_GRID_VELOCITY, POSITION_UPDATE_MUSL_DISPLACEMENT };
 enum specific_volume { SPECIFIC_VOLUME_POINT, SPECIFIC_VOLUME_NODAL_AVERAGE };
 enum velocity_update { VELOCITY_UPDATE_FLIP, VELOCITY_UPDATE_APIC, VELOCITY_UPDATE_AFLIP };
+/* The explicit scheme's stabilisations (002 §3.2) and drag (spec-002 §5.1): the cell average of the
+ * volumetric strain rates of both phases (Eqs. 26-27) or none; the node-based multi-field pressure
+ * rate (Eqs. 28-34) with a constant or a linear basis, or each point's own rate; the drag integrated
+ * at the nodes implicitly over the step (stable at any permeability) or explicitly from the step's
+ * start velocities, as Eq. 22 prints it (stable below dt = 2 / lambda, stable_dt.h). */
+enum strain_rate_smoothing { STRAIN_RATE_SMOOTHING_CELL_AVERAGE, STRAIN_RATE_SMOOTHING_NONE };
+enum pressure_rate_projection { PRESSURE_RATE_MULTI_FIELD, PRESSURE_RATE_NONE };
+enum pressure_rate_basis { PRESSURE_RATE_BASIS_CONSTANT, PRESSURE_RATE_BASIS_LINEAR };
+enum drag_integration { DRAG_IMPLICIT, DRAG_EXPLICIT };
 /* Soil-phase stabilisation (000 §4.4.2, docs/numerics.md): none; F-bar with the node-wise averaged
  * volume change (Eqs. 79-80); modified F-bar (Eq. 81), which also scales Be^t to the patch-wise
  * averaged elastic Jacobian (Eqs. 82-83; patch 1.5 h for B-splines, the cell for linear); and the
  * same with cell-wise patches on any shape (h_patch = h, the comparison of 000 App. A / Fig. 12). */
 enum soil_stabilisation { STABILISATION_NONE, STABILISATION_FBAR, STABILISATION_MODIFIED_FBAR,
-			  STABILISATION_MODIFIED_FBAR_CELLWISE };
+			  STABILISATION_MODIFIED_FBAR_CELLWISE, STABILISATION_BBAR };
+/* The implicit u-p-U scheme's (001 §2.2, spec-001): how the pore-pressure increments reach the
+ * points (the MLSA patch recovery's linear patch at the point, the recovered nodal values
+ * interpolated, or Eq. 11e's direct interpolation), the mass matrices (consistent, A.1a-b as
+ * printed, or lumped), and the Newton iteration's tangent (the elastic one factorised once a step,
+ * 001's modified Newton-Raphson, or the materials' consistent tangent every iteration). */
+enum pressure_recovery { PRESSURE_RECOVERY_MLSA_PATCH, PRESSURE_RECOVERY_MLSA_NODAL, PRESSURE_RECOVERY_NONE };
+enum mass_matrix { MASS_MATRIX_CONSISTENT, MASS_MATRIX_LUMPED };
+enum newton_tangent { NEWTON_TANGENT_ELASTIC, NEWTON_TANGENT_CONSISTENT };
 
 /* Constitutive models (material.h), one file each: "linear_elastic" (small strain), "hencky" (finite
  * strain), the Mohr-Coulomb family returned in principal stress space (principal_return.h):
@@ -107,9 +129,10 @@ enum probe_field { FIELD_PORE_PRESSURE, FIELD_STRESS_XX, FIELD_STRESS_YY, FIELD_
 		   FIELD_DISPLACEMENT_X, FIELD_DISPLACEMENT_Y };
 
 struct case_formulation {
-	enum case_scheme scheme;          /* "semi_implicit" */
+	enum case_scheme scheme;          /* "semi_implicit" or "explicit" (single point only) */
 	enum case_phases phases;          /* "double_point" (default) or "single_point" */
-	enum case_shape shape;            /* "linear", "quadratic_bspline" (default) or "cubic_bspline"; SHAPE_GIMP not offered yet (shape.h) */
+	enum case_shape shape;            /* "linear", "quadratic_bspline" (default), "cubic_bspline" or
+					     "gimp" (uGIMP; the explicit scheme only, shape.h) */
 	int pore_pressure_smoothing;      /* node-wise smoothing, 000 Eq. 77; default true */
 	enum velocity_update velocity_update; /* point velocities: "flip" (default, blended with PIC by
 						 flip_fraction), "apic" (affine PIC, transfer.h) or
@@ -129,6 +152,18 @@ struct case_formulation {
 	enum position_update position_update; /* soil points: "grid_velocity" (default) or "musl_displacement" */
 	enum specific_volume specific_volume; /* the J of Nor-Sand's v = J v0: "point" (default, 000 Eq. 95)
 						 or "nodal_average" (Eqs. 96-97) */
+	/* the explicit scheme's (002 §3.2, spec-002 §5.1) */
+	enum strain_rate_smoothing strain_rate_smoothing;   /* "cell_average" (default) or "none" */
+	enum pressure_rate_projection pressure_rate_projection; /* "multi_field" (default) or "none" */
+	enum pressure_rate_basis pressure_rate_basis;       /* "constant" (default) or "linear" */
+	enum drag_integration drag;                         /* "implicit" (default) or "explicit" */
+	/* the implicit u-p-U scheme's (001, spec-001 §4); soil_stabilisation "bbar" (default) or "none" */
+	double newmark_beta, newmark_gamma;                 /* 0.25, 0.5 (001 §2.2) */
+	enum newton_tangent tangent;                        /* "elastic" (default) or "consistent" */
+	double newton_tolerance;                            /* energy criterion, default 1e-10 */
+	int newton_max_iterations;                          /* default 100 */
+	enum pressure_recovery pressure_recovery;           /* "mlsa_patch" (default), "mlsa_nodal", "none" */
+	enum mass_matrix mass_matrix;                       /* "consistent" (default) or "lumped" */
 };
 
 struct case_grid {
@@ -192,6 +227,10 @@ struct case_body {
 	enum permeability_law permeability_law; /* "constant" (default), "kozeny_carman" (000 step 8g),
 						   "volume_ratio" (k = k0 V/V0) or "volume_ratio_squared"
 						   (k = k0 (V/V0)^2, Xie and Leo 2004) */
+	double initial_pore_pressure;     /* Pa, compression positive, default 0: the points' pore
+					     pressure at t = 0 (002 §4.1 starts at p0 = q with sigma' = 0) */
+	int saturated;                    /* 1 (default): the pores are full of water; 0: a dry body, whose
+					     points carry no water (sim.c, docs/numerics.md "Dry bodies") */
 };
 
 struct case_time_function {
@@ -201,6 +240,8 @@ struct case_time_function {
 	double amplitude;                 /* sinusoid: dimensionless; value = mean + amplitude sin(2 pi f t + phase) */
 	double mean;                      /* sinusoid: dimensionless, default 0 */
 	double phase;                     /* sinusoid: rad */
+	double start;                     /* sinusoid: s, default 0; value 0 before it and t counted
+					     from it (002 §4.3's load begins when gravity has ramped up) */
 };
 
 struct case_boundary {
@@ -234,7 +275,7 @@ struct case_probe {
 };
 
 struct case_spec {
-	char title[CASE_TITLE_MAX + 1];
+	char title[CASE_TITLE_SIZE];      /* UTF-8, at most CASE_TITLE_MAX characters */
 	char warnings[CASE_WARNINGS_SIZE]; /* "" when none (CASE_WARNINGS_SIZE) */
 	struct case_formulation formulation;
 	struct case_grid grid;
@@ -244,10 +285,13 @@ struct case_spec {
 	struct case_body *bodies;
 	struct {
 		double density;           /* rho_w, kg/m^3 */
-		double bulk_modulus;      /* K_w, Pa (unused by the semi-implicit scheme; for the explicit one) */
+		double bulk_modulus;      /* K_w, Pa (the explicit scheme's compressible pore fluid, 002 Eq. 9;
+					     unused by the semi-implicit scheme) */
 		double cavitation_pressure; /* p_cav, the pressure at which the pore water boils, Pa, gauge
 					       (compression positive, as in case files), < 0; 0: no limit,
 					       the water takes any tension as in 000 (cavitation.c) */
+		double grain_bulk_modulus; /* K_s of 001 Eq. 3, Pa: the grains' compressibility in 1/Q =
+					      n / K_w + (1 - n) / K_s; 0 (default): incompressible grains */
 		double cavitated_bulk_modulus; /* K_c, Pa: the stiffness of the water once it has cavitated,
 						  the spring on its vapour (cavitation.c) */
 	} fluid;
@@ -266,7 +310,9 @@ struct case_spec {
 	int load_count;
 	struct case_load *loads;
 	struct {
-		double dt;                /* time step, s, > 0 */
+		double dt;                /* time step, s, > 0; "auto": the scheme's recommended step
+					     (stable_dt.h), written here by the loader */
+		int dt_auto;              /* 1 when the case asked for "auto" */
 		double end;               /* end time, s, > 0 */
 	} time;
 	struct {

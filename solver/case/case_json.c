@@ -348,6 +348,29 @@ int case_read_number(struct case_reader *r, const json_t *obj, const char *base,
 	return v && value_number(r, v, pointer, range, out);
 }
 
+int case_read_number_or_word(struct case_reader *r, const json_t *obj, const char *base, const char *key,
+			     enum case_need need, const struct case_range *range, const char *word, double *out,
+			     int *is_word)
+{
+	char pointer[CASE_POINTER_MAX], shown[CASE_QUOTE_SIZE];
+	const json_t *v = member(r, obj, base, key, need, pointer);
+	*is_word = 0;
+	if (!v)
+		return 0;
+	if (json_is_number(v))
+		return value_number(r, v, pointer, range, out);
+	if (json_is_string(v) && !strcmp(json_string_value(v), word)) {
+		*is_word = 1;
+		return 1;
+	}
+	if (json_is_string(v))
+		case_problem(r, pointer, "expected a number or \"%s\", got \"%s\"", word,
+			     case_quote(shown, json_string_value(v)));
+	else
+		case_problem(r, pointer, "expected a number or \"%s\", got %s", word, type_name(v));
+	return 0;
+}
+
 int case_read_int(struct case_reader *r, const json_t *obj, const char *base, const char *key,
 		  enum case_need need, int lo, int hi, int *out)
 {
@@ -402,6 +425,24 @@ int case_read_string(struct case_reader *r, const json_t *obj, const char *base,
 {
 	char pointer[CASE_POINTER_MAX];
 	return read_string_at(r, obj, base, key, need, out, pointer);
+}
+
+int case_read_short_text(struct case_reader *r, const json_t *obj, const char *base, const char *key,
+			 enum case_need need, int max_chars, char *out)
+{
+	char pointer[CASE_POINTER_MAX];
+	const char *s;
+	if (!read_string_at(r, obj, base, key, need, &s, pointer))
+		return 0;
+	long chars = 0;
+	for (const char *c = s; *c; c++)   /* jansson has checked the UTF-8: count the lead bytes */
+		chars += ((unsigned char)*c & 0xc0) != 0x80;
+	if (chars > max_chars) {
+		case_problem(r, pointer, "must be at most %d characters long, got %ld", max_chars, chars);
+		return 0;
+	}
+	memcpy(out, s, strlen(s) + 1);
+	return 1;
 }
 
 int case_read_choice(struct case_reader *r, const json_t *obj, const char *base, const char *key,

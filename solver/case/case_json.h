@@ -109,12 +109,21 @@ int case_check_range(struct case_reader *r, const char *pointer, double x, const
 /* Member reads (see the conventions above). range may be NULL: any finite number. */
 int case_read_number(struct case_reader *r, const json_t *obj, const char *base, const char *key,
 		     enum case_need need, const struct case_range *range, double *out);
+/* A number in range, or the string word ("auto"): returns 1 with *out set, or with *is_word 1. */
+int case_read_number_or_word(struct case_reader *r, const json_t *obj, const char *base, const char *key,
+			     enum case_need need, const struct case_range *range, const char *word, double *out,
+			     int *is_word);
 int case_read_int(struct case_reader *r, const json_t *obj, const char *base, const char *key,
 		  enum case_need need, int lo, int hi, int *out);
 int case_read_bool(struct case_reader *r, const json_t *obj, const char *base, const char *key,
 		   enum case_need need, int *out);
 int case_read_string(struct case_reader *r, const json_t *obj, const char *base, const char *key,
 		     enum case_need need, const char **out);
+/* A string of at most max_chars characters (Unicode code points, as JSON Schema's maxLength counts
+ * them: a byte count would refuse a title of accented letters that the schema accepts), copied into
+ * out[4 max_chars + 1]. */
+int case_read_short_text(struct case_reader *r, const json_t *obj, const char *base, const char *key,
+			 enum case_need need, int max_chars, char *out);
 /* A string that must be one of names (NULL-terminated); *out is its index. */
 int case_read_choice(struct case_reader *r, const json_t *obj, const char *base, const char *key,
 		     enum case_need need, const char *const *names, int *out);

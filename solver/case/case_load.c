@@ -32,6 +32,7 @@
 #include <string.h>
 
 #include "case_json.h"
+#include "case_formulation.h"
 #include "case_material.h"
 #include "case_region.h"
 #include "stable_dt.h"
@@ -42,35 +43,23 @@
 #define DEFAULT_CAVITATED_BULK_MODULUS 1e6 /* Pa: cavitation.c, docs/numerics.md "Cavitation" */
 #define DEFAULT_GRAVITY_Y -9.81           /* m/s^2 */
 #define DEFAULT_PROGRESS_INTERVAL 1.0     /* s of wall time */
-#define DEFAULT_PRESSURE_STABILISATION_FACTOR 10.0 /* the strongest suppression measured without a
-						      measurable leak (docs/numerics.md) */
-#define DEFAULT_FREE_SURFACE_PENALTY_FACTOR 1e4 /* surface pressure held to about 1e-4 of the interior's,
-						   the matrix still well conditioned for CHOLMOD */
 
 /* Limits. */
-#define GRID_CELLS_MIN 3                  /* cells per direction: room for a quadratic B-spline */
+/* Cells per direction: room for the B-splines' edge treatment (shape.h) and the semi-implicit
+ * scheme's pressure stencils; uGIMP's support fits in 2, which the explicit and implicit schemes take (002
+ * §4.1's column is 2 cells wide). */
+#define GRID_CELLS_MIN 3
+#define GRID_CELLS_MIN_NARROW 2
 #define PARTICLES_PER_CELL_MIN 1
 #define PARTICLES_PER_CELL_MAX 8
 
 static const struct case_range POSITIVE = { BOUND_OPEN, 0, BOUND_NONE, 0 };
 static const struct case_range NON_NEGATIVE = { BOUND_CLOSED, 0, BOUND_NONE, 0 };
-static const struct case_range FRACTION = { BOUND_CLOSED, 0, BOUND_CLOSED, 1 };
 static const struct case_range POROSITY = { BOUND_OPEN, 0, BOUND_OPEN, 1 };
 static const struct case_range NEGATIVE = { BOUND_NONE, 0, BOUND_OPEN, 0 };
 
 /* Names of enum values, in enum order. */
 static const char *const schema_names[] = { CASE_SCHEMA_VERSION, NULL };
-static const char *const scheme_names[] = { "semi_implicit", NULL };
-static const char *const phases_names[] = { "double_point", "single_point", NULL };
-static const char *const shape_names[] = { "linear", "quadratic_bspline", "cubic_bspline", NULL };
-static const char *const projection_names[] = { "laplacian", "consistent", NULL };
-static const char *const pressure_stabilisation_names[] = { "none", "second_difference", NULL };
-static const char *const free_surface_names[] = { "nodes", "interpolated", "weak", NULL };
-static const char *const position_update_names[] = { "grid_velocity", "musl_displacement", NULL };
-static const char *const velocity_update_names[] = { "flip", "apic", "aflip", NULL };
-static const char *const specific_volume_names[] = { "point", "nodal_average", NULL };
-static const char *const stabilisation_names[] = { "none", "fbar", "modified_fbar", "modified_fbar_cellwise",
-							   NULL };
 static const char *const permeability_law_names[] = { "constant", "kozeny_carman", "volume_ratio",
 							       "volume_ratio_squared", NULL };
 static const char *const constraint_names[] = { "free", "slip", "fixed", "plate", NULL };
@@ -83,21 +72,16 @@ static const char *const probe_field_names[] = { "pore_pressure", "stress_xx", "
 static const char *const component_names[] = { "x", "y", NULL };
 
 /* Keys allowed in each object. */
-static const char *const top_keys[] = { "schema", "title", "formulation", "grid", "materials", "bodies",
+static const char *const top_keys[] = { "$schema", "schema", "title", "formulation", "grid", "materials", "bodies",
 					"fluid", "gravity", "boundaries", "loads", "time", "output",
 					"probes", "checkpoint", NULL };
-static const char *const formulation_keys[] = { "scheme", "phases", "shape", "pore_pressure_smoothing",
-						"flip_fraction", "pressure_projection", "soil_stabilisation",
-						"drag_in_correction", "pressure_stabilisation",
-						"pressure_stabilisation_factor", "free_surface",
-						"free_surface_penalty_factor", "position_update", "velocity_update",
-						"specific_volume", NULL };
 static const char *const grid_keys[] = { "origin", "extent", "cell_size", NULL };
 /* A material's own keys; its model's keys are checked by case_read_material_model(). */
 static const char *const material_keys[] = { "name", "density", NULL };
 static const char *const body_keys[] = { "name", "material", "rectangle", "polygon", "particles_per_cell",
-					 "porosity", "hydraulic_conductivity", "permeability_law", NULL };
-static const char *const fluid_keys[] = { "density", "bulk_modulus", "cavitation_pressure",
+					 "porosity", "hydraulic_conductivity", "permeability_law", "saturated",
+					 "initial_pore_pressure", NULL };
+static const char *const fluid_keys[] = { "density", "bulk_modulus", "grain_bulk_modulus", "cavitation_pressure",
 					  "cavitated_bulk_modulus", NULL };
 static const char *const gravity_keys[] = { "acceleration", "ramp_time", "elastic_loading", "loading_conductivity",
 						"water_attached", NULL };
@@ -112,8 +96,8 @@ static const char *const checkpoint_keys[] = { "interval", NULL };
 static const char *const *const time_function_keys[] = {
 	(const char *const[]){ "kind", NULL },
 	(const char *const[]){ "kind", "ramp_time", NULL },
-	(const char *const[]){ "kind", "frequency", "amplitude", "mean", "phase", NULL },
-	(const char *const[]){ "kind", "ramp_time", "frequency", "amplitude", "mean", "phase", NULL },
+	(const char *const[]){ "kind", "frequency", "amplitude", "mean", "phase", "start", NULL },
+	(const char *const[]){ "kind", "ramp_time", "frequency", "amplitude", "mean", "phase", "start", NULL },
 };
 static const char *const *const probe_keys[] = {
 	(const char *const[]){ "name", "kind", "point", NULL },
@@ -159,63 +143,16 @@ static void check_unique(struct case_reader *r, struct case_names *names, const 
 static void read_header(struct case_reader *r, const json_t *root, struct case_spec *c)
 {
 	int version;
-	const char *title;
+	const char *schema_location;
+	/* "$schema" names the JSON Schema for editors (VS Code and others validate and complete
+	 * against it); the solver only checks that it is a string */
+	case_read_string(r, root, "", "$schema", CASE_OPTIONAL, &schema_location);
 	case_read_choice(r, root, "", "schema", CASE_REQUIRED, schema_names, &version);
-	if (!case_read_string(r, root, "", "title", CASE_OPTIONAL, &title))
-		return;
-	size_t length = strlen(title);
-	if (length > CASE_TITLE_MAX)
-		case_problem(r, "/title", "must be at most %d bytes long, got %zu", CASE_TITLE_MAX, length);
-	else
-		memcpy(c->title, title, length + 1);
+	case_read_short_text(r, root, "", "title", CASE_OPTIONAL, CASE_TITLE_MAX, c->title);
 }
 
-static void read_formulation(struct case_reader *r, const json_t *root, struct case_formulation *f)
-{
-	const char *p = "/formulation";
-	const json_t *o = case_read_object(r, root, "", "formulation", CASE_REQUIRED);
-	if (!o)
-		return;
-	case_check_keys(r, o, p, formulation_keys);
-	f->scheme = read_choice_or(r, o, p, "scheme", CASE_REQUIRED, scheme_names, f->scheme);
-	f->phases = read_choice_or(r, o, p, "phases", CASE_OPTIONAL, phases_names, f->phases);
-	f->shape = read_choice_or(r, o, p, "shape", CASE_OPTIONAL, shape_names, f->shape);
-	case_read_bool(r, o, p, "pore_pressure_smoothing", CASE_OPTIONAL, &f->pore_pressure_smoothing);
-	case_read_bool(r, o, p, "drag_in_correction", CASE_OPTIONAL, &f->drag_in_correction);
-	case_read_number(r, o, p, "flip_fraction", CASE_OPTIONAL, &FRACTION, &f->flip_fraction);
-	f->velocity_update = read_choice_or(r, o, p, "velocity_update", CASE_OPTIONAL, velocity_update_names,
-					    f->velocity_update);
-	if (f->velocity_update == VELOCITY_UPDATE_APIC && f->flip_fraction != 1)
-		case_problem(r, "/formulation/flip_fraction", "blends FLIP with PIC and has no meaning with "
-			     "/formulation/velocity_update \"apic\"");
-	f->pressure_projection = read_choice_or(r, o, p, "pressure_projection", CASE_OPTIONAL, projection_names,
-						f->pressure_projection);
-	f->soil_stabilisation = read_choice_or(r, o, p, "soil_stabilisation", CASE_OPTIONAL, stabilisation_names,
-					       f->soil_stabilisation);
-	f->pressure_stabilisation = read_choice_or(r, o, p, "pressure_stabilisation", CASE_OPTIONAL,
-						   pressure_stabilisation_names, f->pressure_stabilisation);
-	case_read_number(r, o, p, "pressure_stabilisation_factor", CASE_OPTIONAL, &POSITIVE,
-			 &f->pressure_stabilisation_factor);
-	/* the penalty is written into the consistent projection's energy (pressure_stabilisation.c) */
-	if (f->pressure_stabilisation != PRESSURE_STABILISATION_NONE && f->pressure_projection != PROJECTION_CONSISTENT)
-		case_problem(r, "/formulation/pressure_stabilisation",
-			     "\"%s\" needs /formulation/pressure_projection \"consistent\"",
-			     pressure_stabilisation_names[f->pressure_stabilisation]);
-	f->position_update = read_choice_or(r, o, p, "position_update", CASE_OPTIONAL, position_update_names,
-					    f->position_update);
-	f->specific_volume = read_choice_or(r, o, p, "specific_volume", CASE_OPTIONAL, specific_volume_names,
-					    f->specific_volume);
-	f->free_surface = read_choice_or(r, o, p, "free_surface", CASE_OPTIONAL, free_surface_names, f->free_surface);
-	case_read_number(r, o, p, "free_surface_penalty_factor", CASE_OPTIONAL, &POSITIVE,
-			 &f->free_surface_penalty_factor);
-	/* measured to spoil the Laplacian's Terzaghi column eightfold (docs/numerics.md, "Free surface") */
-	if (f->free_surface != FREE_SURFACE_NODES && f->pressure_projection != PROJECTION_CONSISTENT)
-		case_problem(r, "/formulation/free_surface", "\"%s\" needs /formulation/pressure_projection \"consistent\"",
-			     free_surface_names[f->free_surface]);
-}
-
-/* Checks that extent[d] is a whole number, at least GRID_CELLS_MIN, of cells. */
-static int check_cell_count(struct case_reader *r, const struct case_grid *g, int d)
+/* Checks that extent[d] is a whole number, at least `least` (GRID_CELLS_MIN...), of cells. */
+static int check_cell_count(struct case_reader *r, const struct case_grid *g, int d, int least)
 {
 	char pointer[CASE_POINTER_MAX], h[CASE_NUMBER_SIZE], got[CASE_NUMBER_SIZE];
 	case_pointer_index(pointer, "/grid/extent", (size_t)d);
@@ -225,16 +162,17 @@ static int check_cell_count(struct case_reader *r, const struct case_grid *g, in
 			     case_format_number(h, g->cell_size), case_format_number(got, g->extent[d]));
 		return 0;
 	}
-	if (cells < GRID_CELLS_MIN) {
+	if (cells < least) {
 		case_problem(r, pointer, "must span at least %d cells of /grid/cell_size, got %.0f",
-			     GRID_CELLS_MIN, cells);
+			     least, cells);
 		return 0;
 	}
 	return 1;
 }
 
 /* Returns 1 when the grid is complete and valid, so bodies and probes can be checked against it. */
-static int read_grid(struct case_reader *r, const json_t *root, struct case_grid *g)
+static int read_grid(struct case_reader *r, const json_t *root, const struct case_formulation *form,
+		     struct case_grid *g)
 {
 	const char *p = "/grid";
 	const json_t *o = case_read_object(r, root, "", "grid", CASE_REQUIRED);
@@ -245,8 +183,10 @@ static int read_grid(struct case_reader *r, const json_t *root, struct case_grid
 	int extent_ok = case_read_vec2(r, o, p, "extent", CASE_REQUIRED, &POSITIVE, g->extent);
 	int cell_size_ok = case_read_number(r, o, p, "cell_size", CASE_REQUIRED, &POSITIVE, &g->cell_size);
 	if (extent_ok && cell_size_ok) {
-		extent_ok &= check_cell_count(r, g, 0);
-		extent_ok &= check_cell_count(r, g, 1);
+		const int least = form->shape == SHAPE_GIMP && form->scheme != SCHEME_SEMI_IMPLICIT ? GRID_CELLS_MIN_NARROW
+												: GRID_CELLS_MIN;
+		extent_ok &= check_cell_count(r, g, 0, least);
+		extent_ok &= check_cell_count(r, g, 1, least);
 	}
 	/* checked before anything is sized from the grid; each direction is then below 2^31 too */
 	if (extent_ok && cell_size_ok)
@@ -319,6 +259,28 @@ static int read_body(struct case_reader *r, const json_t *o, const char *p, cons
 			 &b->hydraulic_conductivity);
 	b->permeability_law = read_choice_or(r, o, p, "permeability_law", CASE_OPTIONAL,
 					     permeability_law_names, b->permeability_law);
+	case_read_number(r, o, p, "initial_pore_pressure", CASE_OPTIONAL, NULL, &b->initial_pore_pressure);
+	b->saturated = 1;
+	if (case_read_bool(r, o, p, "saturated", CASE_OPTIONAL, &b->saturated) && !b->saturated &&
+	    c->formulation.pressure_projection != PROJECTION_LAPLACIAN) {
+		/* measured with the Laplacian only: the consistent projection's low-permeability options
+		 * diverged on a dry fill (docs/numerics.md, "Dry bodies") */
+		char pointer[CASE_POINTER_MAX];
+		case_pointer_key(pointer, p, "saturated");
+		case_problem(r, pointer, "false needs /formulation/pressure_projection \"laplacian\": a dry body's "
+			     "contact is verified with it alone");
+	}
+	if (!b->saturated && c->formulation.scheme != SCHEME_SEMI_IMPLICIT) {
+		/* the other schemes' single-point water rides on every soil point */
+		char pointer[CASE_POINTER_MAX];
+		case_pointer_key(pointer, p, "saturated");
+		case_problem(r, pointer, "false applies to the \"semi_implicit\" scheme only");
+	}
+	if (!b->saturated && b->initial_pore_pressure != 0.0) {
+		char pointer[CASE_POINTER_MAX];
+		case_pointer_key(pointer, p, "initial_pore_pressure");
+		case_problem(r, pointer, "a dry body (\"saturated\": false) has no pore water to hold a pressure");
+	}
 	return seeded;
 }
 
@@ -360,6 +322,7 @@ static void read_fluid(struct case_reader *r, const json_t *root, struct case_sp
 	case_check_keys(r, o, "/fluid", fluid_keys);
 	case_read_number(r, o, "/fluid", "density", CASE_OPTIONAL, &POSITIVE, &c->fluid.density);
 	case_read_number(r, o, "/fluid", "bulk_modulus", CASE_OPTIONAL, &POSITIVE, &c->fluid.bulk_modulus);
+	case_read_number(r, o, "/fluid", "grain_bulk_modulus", CASE_OPTIONAL, &POSITIVE, &c->fluid.grain_bulk_modulus);
 	case_read_number(r, o, "/fluid", "cavitation_pressure", CASE_OPTIONAL, &NEGATIVE,
 			 &c->fluid.cavitation_pressure);
 	case_read_number(r, o, "/fluid", "cavitated_bulk_modulus", CASE_OPTIONAL, &POSITIVE,
@@ -497,6 +460,7 @@ static void read_time_function(struct case_reader *r, const json_t *o, const cha
 	case_read_number(r, t, p, "amplitude", CASE_REQUIRED, NULL, &tf->amplitude);
 	case_read_number(r, t, p, "mean", CASE_OPTIONAL, NULL, &tf->mean);
 	case_read_number(r, t, p, "phase", CASE_OPTIONAL, NULL, &tf->phase);
+	case_read_number(r, t, p, "start", CASE_OPTIONAL, &NON_NEGATIVE, &tf->start);
 }
 
 /* Reads from/to, defaulting to the whole face of the body's bounding box (body and face valid),
@@ -576,8 +540,22 @@ static int read_time(struct case_reader *r, const json_t *root, struct case_spec
 	if (!o)
 		return 0;
 	case_check_keys(r, o, "/time", time_keys);
-	int ok = case_read_number(r, o, "/time", "dt", CASE_REQUIRED, &POSITIVE, &c->time.dt);
+	int ok = case_read_number_or_word(r, o, "/time", "dt", CASE_REQUIRED, &POSITIVE, "auto", &c->time.dt,
+					  &c->time.dt_auto);
 	ok &= case_read_number(r, o, "/time", "end", CASE_REQUIRED, &POSITIVE, &c->time.end);
+	if (ok && c->time.dt_auto && c->formulation.scheme == SCHEME_IMPLICIT_UPU) {
+		case_problem(r, "/time/dt", "\"auto\" has no meaning for the \"implicit_upU\" scheme, stable at any "
+			     "step: choose dt by the accuracy wanted");
+		return 0;
+	}
+	if (ok && c->time.dt_auto) {
+		/* the scheme's recommended step, known once everything it follows from was read */
+		struct stable_dt e;
+		stable_dt_estimate(c, &e);
+		if (r->problem_count || e.body < 0)
+			return 0;
+		c->time.dt = fmin(stable_dt_recommended(&e), c->time.end);
+	}
 	if (ok && c->time.dt > c->time.end) {
 		case_problem(r, "/time/dt", "must be <= /time/end (%s), got %s",
 			     case_format_number(end, c->time.end), case_format_number(dt, c->time.dt));
@@ -596,9 +574,9 @@ static void check_stable_dt(struct case_reader *r, const struct case_spec *c)
 	stable_dt_estimate(c, &e);
 	if (e.body < 0 || !(c->time.dt > stable_dt_max(&e)))
 		return;
-	case_problem(r, "/time/dt", "must be at most %.3g s, %.3g times the soil skeleton's CFL step h / c_p = %.3g s "
-		     "(c_p = sqrt((K + 4G/3) / ((1 - n) rho_s)) = %.4g m/s in body '%s'), got %s",
-		     stable_dt_max(&e), STABLE_DT_MAX_FACTOR, e.cfl, e.wave_speed, c->bodies[e.body].name,
+	char bound[STABLE_DT_DESCRIPTION_SIZE];
+	stable_dt_describe(&e, c, bound, sizeof bound);
+	case_problem(r, "/time/dt", "must be at most %.3g s, %s, got %s (or write \"auto\")", stable_dt_max(&e), bound,
 		     case_format_number(dt, c->time.dt));
 }
 
@@ -685,19 +663,7 @@ static void read_probes(struct case_reader *r, const json_t *root, struct case_s
 
 static void set_defaults(struct case_spec *c)
 {
-	c->formulation.scheme = SCHEME_SEMI_IMPLICIT;
-	c->formulation.phases = PHASES_DOUBLE_POINT;
-	c->formulation.shape = SHAPE_QUADRATIC_BSPLINE;
-	c->formulation.pore_pressure_smoothing = 1;
-	c->formulation.flip_fraction = 1;
-	c->formulation.velocity_update = VELOCITY_UPDATE_FLIP;
-	c->formulation.drag_in_correction = 0;
-	c->formulation.pressure_stabilisation = PRESSURE_STABILISATION_NONE;
-	c->formulation.pressure_stabilisation_factor = DEFAULT_PRESSURE_STABILISATION_FACTOR;
-	c->formulation.free_surface = FREE_SURFACE_NODES;
-	c->formulation.free_surface_penalty_factor = DEFAULT_FREE_SURFACE_PENALTY_FACTOR;
-	c->formulation.position_update = POSITION_UPDATE_GRID_VELOCITY;
-	c->formulation.specific_volume = SPECIFIC_VOLUME_POINT;
+	case_formulation_defaults(&c->formulation);
 	c->fluid.density = DEFAULT_FLUID_DENSITY;
 	c->fluid.bulk_modulus = DEFAULT_FLUID_BULK_MODULUS;
 	c->fluid.cavitated_bulk_modulus = DEFAULT_CAVITATED_BULK_MODULUS;
@@ -717,8 +683,8 @@ static void read_case(struct case_reader *r, const json_t *root, struct case_spe
 {
 	case_check_keys(r, root, "", top_keys);
 	read_header(r, root, c);
-	read_formulation(r, root, &c->formulation);
-	int grid_ok = read_grid(r, root, &c->grid);
+	case_read_formulation(r, root, &c->formulation);
+	int grid_ok = read_grid(r, root, &c->formulation, &c->grid);
 	struct case_names materials, bodies;
 	case_names_init(r, &materials);
 	case_names_init(r, &bodies);
@@ -729,6 +695,7 @@ static void read_case(struct case_reader *r, const json_t *root, struct case_spe
 	read_gravity(r, root, c);
 	read_boundaries(r, root, c->boundaries);
 	check_plates(r, c);
+	case_check_scheme(r, c);
 	read_loads(r, root, c, bodies_read ? &bodies : NULL);
 	case_names_release(&bodies);
 	int time_ok = read_time(r, root, c);
@@ -856,7 +823,9 @@ double case_time_function_value(const struct case_time_function *f, double t)
 		/* A ramp of zero length is a step; validated cases always have ramp_time > 0. */
 		return f->ramp_time > 0 ? fmin(t / f->ramp_time, 1) : 1;
 	case TIME_SINUSOID:
-		return f->mean + f->amplitude * sin(two_pi * f->frequency * t + f->phase);
+		if (t < f->start)
+			return 0;   /* the load has not begun */
+		return f->mean + f->amplitude * sin(two_pi * f->frequency * (t - f->start) + f->phase);
 	}
 	return 1;
 }

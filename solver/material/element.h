@@ -31,7 +31,7 @@
 enum element_test { ELEMENT_DRAINED, ELEMENT_UNDRAINED };
 
 struct element_case {
-	char title[256];
+	char title[CASE_TITLE_SIZE];      /* UTF-8, at most CASE_TITLE_MAX characters (case.h) */
 	char warnings[CASE_WARNINGS_SIZE]; /* "" when none (case.h) */
 	struct case_material material;    /* model and parameters (case_material.h keys) */
 	enum element_test test;           /* "drained" | "undrained" */

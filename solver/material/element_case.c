@@ -12,7 +12,7 @@
 
 static const char *const schema_names[] = { ELEMENT_SCHEMA_VERSION, NULL };
 static const char *const test_names[] = { "drained", "undrained", NULL };
-static const char *const top_keys[] = { "schema", "title", "material", "test", "confining_pressure",
+static const char *const top_keys[] = { "$schema", "schema", "title", "material", "test", "confining_pressure",
 					"axial_strain", "steps", NULL };
 
 static const struct case_range NON_NEGATIVE = { BOUND_CLOSED, 0, BOUND_NONE, 0 };
@@ -23,15 +23,12 @@ static const struct case_range LOG_STRAIN = { BOUND_OPEN, -ELEMENT_LOG_STRAIN_MA
 static void read_element(struct case_reader *r, const json_t *root, struct element_case *c)
 {
 	int version, test = ELEMENT_DRAINED;
-	const char *title;
+	const char *schema_location;
 	case_check_keys(r, root, "", top_keys);
+	/* the editor's schema (schemas/element.schema.json), as in a simulation case (case_load.c) */
+	case_read_string(r, root, "", "$schema", CASE_OPTIONAL, &schema_location);
 	case_read_choice(r, root, "", "schema", CASE_REQUIRED, schema_names, &version);
-	if (case_read_string(r, root, "", "title", CASE_OPTIONAL, &title)) {
-		if (strlen(title) >= sizeof c->title)
-			case_problem(r, "/title", "must be at most %zu bytes long", sizeof c->title - 1);
-		else
-			strcpy(c->title, title);
-	}
+	case_read_short_text(r, root, "", "title", CASE_OPTIONAL, CASE_TITLE_MAX, c->title);
 	const json_t *m = case_read_object(r, root, "", "material", CASE_REQUIRED);
 	if (m)
 		case_read_material_model(r, m, "/material", NULL, &c->material);

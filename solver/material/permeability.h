@@ -22,4 +22,9 @@
  * and volume ratio J (0 < n0, n < 1; J > 0, as the caller has checked). */
 double permeability_conductivity(enum permeability_law law, double k0, double n0, double n, double J);
 
+/* Standard gravity in the drag term n^2 rho_w g / k (000 Eq. 15, 002 Eq. 12): hydraulic
+ * conductivity is defined with it, so it stays 9.81 m/s^2 even when a case switches the body force
+ * off. */
+#define CONDUCTIVITY_GRAVITY 9.81
+
 #endif

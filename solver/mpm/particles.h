@@ -54,6 +54,16 @@ struct particles {
 	double *state;              /* [STATE_MAX n] constitutive internal variables */
 	double *plastic_strain;     /* [n] accumulated plastic strain (0 for elastic models) */
 	double *dF;                 /* [4n] scratch: deformation gradient increment of this step */
+	double *dF_zz;              /* [n] its out-of-plane stretch, for a scheme whose smoothed volumetric
+				       rate has a zz part (002 Eq. 27); NULL: plane strain, dF_zz = 1 */
+
+	/* the implicit u-p-U scheme's state between steps (001 Eq. 11; NULL for the other schemes),
+	 * each set its own: the soil set's for the solid, the water set's for the water */
+	double *acceleration;       /* [2n] the phase's acceleration at the point, m/s^2 (Eq. 11a-b) */
+	double *volumetric_strain;  /* [n] the phase's volumetric strain since the reference state, eps_v^u
+				       (soil set) or eps_v^U (water set), expansion positive (Eq. 10b) */
+	double *pressure0;          /* [n] water set: the pore pressure of the reference state, p0 of
+				       Eq. 10b, Pa, tension positive like pressure */
 	double *surface;            /* [2n] loaded-face length vector N dA in the reference configuration,
 				       m per m (zero for interior points); see loads.c */
 	int *surface_load;          /* [n] index of the case load acting on the point, -1 if none */
@@ -63,10 +73,11 @@ struct particles {
 	idx_t *node0;               /* [n] linear index of the lower-left support node */
 	double *shape;              /* [4 SHAPE_SUPPORT_MAX n] the 1-D factors of S_Ip: point q's block of
 				       4 support values at 4 support q (see particle_shape) */
-	struct point_blocks *blocks; /* the cache's points by block of node0, the order in which the
-				       scatters run in parallel (point_blocks.h), sorted by
-				       shape_evaluate; owned. NULL: scatters run serially in index
-				       order. An aliased set has none and uses its soil set's */
+	struct point_blocks *blocks; /* the points by block of the cells that hold them, the order in
+				       which the scatters run in parallel (point_blocks.h), sorted by
+				       shape_evaluate with the cache; owned. NULL: scatters run
+				       serially in index order. An aliased set has none and uses its
+				       soil set's */
 };
 
 /* The shape functions are tensor products: for the support node a + b support (a along x, b
@@ -95,6 +106,13 @@ enum poro_status particles_init_alias(struct particles *w, const struct particle
 
 /* Gives p an affine velocity array C, zeroed (APIC, transfer.h). Returns PORO_ENOMEM on failure. */
 enum poro_status particles_add_affine(struct particles *p, struct poro_error *err);
+
+/* Gives p an out-of-plane stretch array dF_zz, zeroed. Returns PORO_ENOMEM on failure. */
+enum poro_status particles_add_out_of_plane(struct particles *p, struct poro_error *err);
+
+/* Gives p the implicit scheme's acceleration, volumetric_strain and pressure0 arrays, zeroed.
+ * Returns PORO_ENOMEM on failure. */
+enum poro_status particles_add_implicit_state(struct particles *p, struct poro_error *err);
 
 /* Gives p the scatter blocks of grid g for its n points, POINT_BLOCK_CELLS_X x POINT_BLOCK_CELLS_Y
  * cells each (point_blocks.h); shape_evaluate sorts them from then on. Returns PORO_ENOMEM on

@@ -81,6 +81,11 @@ void deformation_increment(struct sim *s, const double *du);
  * when a point inverts or its porosity leaves (0, 1). */
 enum poro_status deformation_apply(struct sim *s);
 
+/* The same with each point's volume following a volumetric strain rate of its own instead of
+ * det(dF): V <- V (1 + dt rate_p), the volume update of 002 §3.3 step 8 with the cell-averaged rate
+ * of Eqs. 26-27, so that volume, porosity and pore pressure see one rate; F still takes dF. */
+enum poro_status deformation_apply_volumetric(struct sim *s, const double *rate);
+
 /* ---- fbar.c ---------------------------------------------------------------------------------- */
 
 /* Lays out the modified F-bar's fixed patches (000 §4.4.2, Eq. 83) once, at create. */

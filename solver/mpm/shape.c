@@ -105,32 +105,6 @@ static int cubic_1d(double xi, idx_t cells, double inv_h, idx_t *i0, double *w, 
 	return 0;
 }
 
-/* G(u) = integral of the hat max(0, 1 - |t|) from -1 to u (u in cells from the node): the
- * antiderivative GIMP's weights are differences of. */
-static inline double hat_integral(double u)
-{
-	if (u <= -1.0)
-		return 0.0;
-	if (u <= 0.0)
-		return 0.5 * (1.0 + u) * (1.0 + u);
-	if (u <= 1.0)
-		return 1.0 - 0.5 * (1.0 - u) * (1.0 - u);
-	return 1.0;
-}
-
-static inline double hat(double u)
-{
-	return fmax(0.0, 1.0 - fabs(u));
-}
-
-/* uGIMP (Bardenhagen and Kober 2004): S_I(x_p) = (1/|D|) integral over the point's domain D of the
- * linear hat N_I, with D = [xi - lambda, xi + lambda] (lambda the half width in cells, at most 1/2)
- * clipped to the grid [0, cells]. Clipping keeps the partition of unity where a domain reaches
- * past the edge; inside the grid this is the familiar piecewise form (1 - (d^2 + lambda^2) /
- * (2 lambda) for |d| < lambda, 1 - |d| between, (1 + lambda - |d|)^2 / (4 lambda) in the outer
- * band, d = xi - I in cells). With a = max(xi - lambda, 0), b = min(xi + lambda, cells) and a', b'
- * their derivatives in xi (1, or 0 where clipped), dS/dxi = (N(b) b' - N(a) a' - S (b' - a')) /
- * (b - a). lambda = 0 gives the linear hat. */
 static inline int gimp_1d(double xi, double lambda, idx_t cells, double inv_h, idx_t *i0, double *w, double *dw)
 {
 	if (lambda <= 0.0) {             /* the hat itself, on 3 nodes that stay inside the grid */
@@ -146,16 +120,49 @@ static inline int gimp_1d(double xi, double lambda, idx_t cells, double inv_h, i
 		return 0;
 	}
 	const double a = fmax(xi - lambda, 0.0), b = fmin(xi + lambda, (double)cells);
-	const double da = xi - lambda > 0.0 ? 1.0 : 0.0, db = xi + lambda < (double)cells ? 1.0 : 0.0;
-	idx_t i = (idx_t)floor(a);        /* the domain [a, b], at most a cell long, meets nodes i .. i + 2 */
-	if (i > cells - 2)
-		i = cells - 2;              /* needs cells >= 2; the extra node then gets weight 0 */
+	/* The domain [a, b], at most a cell long, lies in the cells [i, i + 1] and [i + 1, i + 2],
+	 * i = floor(a), where the hats are linear: s = a - i and m = min(b, i + 1) - i the part in the
+	 * first cell, u = b - (i + 1) the part in the second (0 if none). In the first cell N_i = 1 - t,
+	 * N_i+1 = t; in the second N_i+1 = 1 - t, N_i+2 = t (t from the cell's left node); the integrals
+	 * and the mean gradients follow in closed form. */
+	idx_t i = (idx_t)floor(a);
+	const double s = a - (double)i, m = fmin(b - (double)i, 1.0), u = fmax(b - (double)i - 1.0, 0.0);
+	const double inv_len = 1.0 / (b - a), first = m - s, half_sq = 0.5 * (m * m - s * s), u_sq = 0.5 * u * u;
+	w[0] = (first - half_sq) * inv_len;
+	w[1] = (half_sq + u - u_sq) * inv_len;
+	w[2] = u_sq * inv_len;
+	dw[0] = -first * inv_len * inv_h;
+	dw[1] = (first - u) * inv_len * inv_h;
+	dw[2] = u * inv_len * inv_h;
+	if (i > cells - 2) {      /* a domain in the last cell: its nodes are the upper two of the three */
+		w[2] = w[1], w[1] = w[0], w[0] = 0.0;
+		dw[2] = dw[1], dw[1] = dw[0], dw[0] = 0.0;
+		i = cells - 2;    /* needs cells >= 2 */
+	}
 	*i0 = i;
+	return 0;
+}
+
+int shape_1d_gimp_cell_centre(double xi, double half_width, idx_t cells, double inv_h, idx_t *i0, double *G,
+			      double *W)
+{
+	if (!(xi >= 0.0 && xi <= (double)cells) || !(half_width > 0.0))
+		return -1;
+	const double a = fmax(xi - half_width, 0.0), b = fmin(xi + half_width, (double)cells), inv_len = 1.0 / (b - a);
+	idx_t i = (idx_t)floor(a);
 	for (int k = 0; k < 3; k++) {
 		const double node = (double)(i + k);
-		w[k] = (hat_integral(b - node) - hat_integral(a - node)) / (b - a);
-		dw[k] = (hat(b - node) * db - hat(a - node) * da - w[k] * (db - da)) / (b - a) * inv_h;
+		const double left = fmax(0.0, fmin(b, node) - fmax(a, node - 1.0));    /* in [node - 1, node] */
+		const double right = fmax(0.0, fmin(b, node + 1.0) - fmax(a, node));   /* in [node, node + 1] */
+		G[k] = (left - right) * inv_len * inv_h;
+		W[k] = (left + right) * inv_len;
 	}
+	if (i > cells - 2) {      /* as gimp_1d: the nodes are the upper two of the three */
+		G[2] = G[1], G[1] = G[0], G[0] = 0.0;
+		W[2] = W[1], W[1] = W[0], W[0] = 0.0;
+		i = cells - 2;
+	}
+	*i0 = i;
 	return 0;
 }
 
@@ -214,7 +221,7 @@ static inline int evaluate_point(const struct grid *g, enum case_shape kind, con
 	const double eta = (p->x[2 * q + 1] - g->origin[1]) * g->inv_h;
 	if (kind == SHAPE_GIMP) {
 		/* uGIMP: the square domain of the point's initial volume, kept through the motion */
-		const double lambda = fmin(0.5 * sqrt(p->volume0[q]) * g->inv_h, 0.5);   /* one point per cell at most */
+		const double lambda = shape_gimp_half_width(g, p->volume0[q]);
 		if (shape_1d_gimp(xi, lambda, g->cells[0], g->inv_h, &i0, f, f + 2 * S) ||
 		    shape_1d_gimp(eta, lambda, g->cells[1], g->inv_h, &j0, f + S, f + 3 * S))
 			return -1;

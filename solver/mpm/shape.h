@@ -42,6 +42,8 @@
 #ifndef PORO_SHAPE_H
 #define PORO_SHAPE_H
 
+#include <math.h>
+
 #include "grid.h"
 
 /* Support nodes per direction for a shape kind. */
@@ -55,6 +57,25 @@ int shape_1d(enum case_shape kind, double xi, idx_t cells, double inv_h, idx_t *
 /* uGIMP's 1-D weights for a point of half width `half_width` (cells, in [0, 1/2]); 3 support
  * nodes. Returns 0, or -1 if xi lies outside [0, cells]. */
 int shape_1d_gimp(double xi, double half_width, idx_t cells, double inv_h, idx_t *i0, double *w, double *dw);
+
+/* uGIMP's half width of a point of initial volume V0, in cells: half the side of the square of area
+ * V0, at most 1/2 (one point per cell). */
+static inline double shape_gimp_half_width(const struct grid *g, double volume0)
+{
+	const double half = 0.5 * sqrt(volume0) * g->inv_h;
+	return half < 0.5 ? half : 0.5;
+}
+
+/* uGIMP sampled at the cell centres, for the B-bar of 001 Eqs. 12-16 (spec-001 §3.2): for each of
+ * the 3 support nodes (the same i0 as shape_1d_gimp), with o_L and o_R the parts of the point's
+ * domain in the node's left and right cells and L the domain's length (clipped to the grid),
+ *     G = (o_L - o_R) / (L h)   the overlap-weighted centre gradient of the node's hat, per metre,
+ *     W = (o_L + o_R) / L       the share of the domain in the node's two cells.
+ * In 2-D the cell-centre gradient of node (a, b) is (G_x[a] W_y[b], W_x[a] G_y[b]) / 2: the other
+ * direction's hat is 1/2 at a cell's centre. A domain inside one cell gives the Q4 centre gradient
+ * -1/(2h) to its lower-left node. Returns -1 for xi outside [0, cells] or a zero half width. */
+int shape_1d_gimp_cell_centre(double xi, double half_width, idx_t cells, double inv_h, idx_t *i0, double *G,
+			      double *W);
 
 /* Weights of the support nodes at one location x (for surface quadrature points that are not
  * material points). Writes the first support node and support^2 weights, node order i fastest.

@@ -39,6 +39,7 @@ enum poro_status stress_update(struct sim *s)
 			}
 			struct stress_update u = {
 				.dF = dF,
+				.dF_zz = p->dF_zz ? p->dF_zz[q] : 0.0,
 				.J = p->volume[q] / p->volume0[q],
 				.J_v = J_v ? J_v[q] : 0.0,
 				.stress = p->stress + 4 * q,

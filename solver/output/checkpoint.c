@@ -77,6 +77,10 @@ static const struct saved_array saved_arrays[] = {
 	{"plastic_strain", MEMBER(plastic_strain), 1, 0, 0},
 	{"surface", MEMBER(surface), 2, 0, 0},
 	{"surface_load", MEMBER(surface_load), 1, 1, 0},
+	/* the implicit u-p-U scheme's (NULL, not saved, otherwise); each set owns its own */
+	{"acceleration", MEMBER(acceleration), 2, 0, 1},
+	{"volumetric_strain", MEMBER(volumetric_strain), 1, 0, 1},
+	{"pressure0", MEMBER(pressure0), 1, 0, 1},
 };
 
 #define SAVED_COUNT (sizeof saved_arrays / sizeof saved_arrays[0])
@@ -413,19 +417,19 @@ static enum poro_status load_contents(struct sim *s, hid_t file, const char *nam
 	enum poro_status st = read_header(s, file, name, &step, &time, &outflow);
 	if (!st)
 		st = check_case(s, file, name);
-	const long soil_n = s->soil.n;
+	const long soil_n = s->soil.n, water_n = s->water.n;
 	if (!st)
 		st = read_set(s, file, "soil", &s->soil, soil_n, name);
 	if (!st && s->soil.n != soil_n)
 		st = poro_error_set(&s->err, PORO_EINVAL, "checkpoint '%s' has %ld soil points, the case gives %ld",
 				    name, (long)s->soil.n, soil_n);
-	/* a double-point water set is allocated with one point per soil point (sim.c) and only
-	 * loses points; a single-point one has exactly the soil's */
+	/* a double-point water set is allocated with one point per soil point of a saturated body
+	 * (sim.c) and only loses points; a single-point one rides on exactly those soil points */
 	if (!st)
-		st = read_set(s, file, "water", &s->water, soil_n, name);
-	if (!st && !s->double_point && s->water.n != soil_n)
+		st = read_set(s, file, "water", &s->water, water_n, name);
+	if (!st && !s->double_point && s->water.n != water_n)
 		st = poro_error_set(&s->err, PORO_EINVAL, "checkpoint '%s' has %ld water values, the case gives %ld",
-				    name, (long)s->water.n, soil_n);
+				    name, (long)s->water.n, water_n);
 	if (!st)
 		st = read_probe_points(s, file, name);
 	if (st)

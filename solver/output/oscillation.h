@@ -1,7 +1,9 @@
 /*
- * oscillation.h - the oscillation index of the soil's mean effective stress: a measure of the
+ * oscillation.h - the oscillation index of the soil's mean effective stress (or of any point field,
+ * such as the pore pressure): a measure of the
  * point-to-point stress noise that volumetric locking leaves (000 §4.4.2, App. A, Fig. 12), for
- * tests and reports.
+ * tests and reports; and the two-cell pattern index, which finds a pattern of period two cells
+ * whatever its phase against the cells.
  *
  * Definition (docs/numerics.md). Points are neighbours when their reference positions x0 are one
  * seeding spacing apart along x or along y (the lattice sim.c seeds). With p'_i =
@@ -21,6 +23,22 @@
  * same overshoot rule to the means of p' over blocks of block x block lattice sites (block =
  * particles_per_cell: the cells the points were seeded in), each block against its neighbouring
  * blocks, normalised by the RMS of the block means. block = 1 is oscillation_index().
+ *
+ * A pattern of period two cells centred on the nodes. A nodal pressure alternating from node to
+ * node, p_I = (-1)^i A, interpolated by the quadratic B-splines, is A (1/2 - 2 s^2) (-1)^i at
+ * s cells from node i (|s| <= 1/2): with 2x2 points per cell the two points either side of a node
+ * carry 3A/8 of the same sign, with 4x4 the four carry 0.22, 0.47, 0.47, 0.22 A. Each point then
+ * equals a neighbour along x (point index 0), and each cell holds as much high as low pressure
+ * (cell means equal: block index 0), while the field swings by 3A/4 over one cell. This is the
+ * pressure mode the consistent projection cannot see (pressure.c; docs/numerics.md, "A pressure
+ * pattern of period two cells"). oscillation_index_pattern() applies the block rule to blocks
+ * of block x block sites laid at each of the block x block offsets of their lattice (0 .. block-1
+ * sites along x and along y), counting only blocks with a point at every site (a partial block's
+ * mean is its points' centroid's value, not its centre's, and a row of them along a sloping
+ * surface can zigzag), and takes the largest of the block^2 indices: the blocks centred on the
+ * nodes see the pattern above at 2 (3A/8) / P with 2x2 points, the blocks on the cells see a
+ * checkerboard of cells, and a smooth field or a cell-wise constant monotone one (patch
+ * averaging, Eq. 83) scores 0 at every offset, apart from true extrema.
  */
 #ifndef PORO_OSCILLATION_H
 #define PORO_OSCILLATION_H
@@ -39,5 +57,18 @@ enum poro_status oscillation_index(const struct case_grid *g, const struct parti
 /* The same over blocks of block x block lattice sites (see above); PORO_EINVAL also for block < 1. */
 enum poro_status oscillation_index_blocks(const struct case_grid *g, const struct particles *p, double spacing,
 					  int block, double *index, struct poro_error *err);
+
+/* The same index of any per-point scalar field of p (value[n]; NULL: the mean effective stress),
+ * e.g. the pore pressure, whose checkerboard 002 §4.2 shows without its stabilisations (Fig. 10b).
+ * "Zero" then refers to that field. */
+enum poro_status oscillation_index_of(const struct case_grid *g, const struct particles *p, double spacing,
+				      int block, const double *value, double *index, struct poro_error *err);
+
+/* The two-cell pattern index of value[n] (NULL: the mean effective stress) over blocks of
+ * block x block sites (block = particles_per_cell: the cells), the largest over the placements of
+ * the blocks (above). PORO_EINVAL as above when no placement has a full block between two full
+ * ones along a line or the field is zero. */
+enum poro_status oscillation_index_pattern(const struct case_grid *g, const struct particles *p, double spacing,
+					   int block, const double *value, double *index, struct poro_error *err);
 
 #endif

@@ -115,7 +115,8 @@ static enum poro_status load(struct report *rep, const char *path, const struct 
 				      case_err.message);
 	const struct case_spec *c = rep->spec;
 	rep->h = c->grid.cell_size;
-	rep->spacing = rep->h / c->bodies[0].particles_per_cell;
+	rep->particles_per_cell = c->bodies[0].particles_per_cell;
+	rep->spacing = rep->h / rep->particles_per_cell;
 	rep->double_point = c->formulation.phases == PHASES_DOUBLE_POINT;
 	rep->columns = lround(c->grid.extent[0] / rep->h);
 	if (rep->columns < 1)

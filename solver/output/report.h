@@ -1,8 +1,8 @@
 /*
  * report.h - what a user wants from a large-deformation run, derived from its result.h5 (000 §5.3,
  * slope failure; §5.4, landslides): per frame the toe and run-out of the sliding soil, the crest
- * settlement, the largest gap between the soil and the water surfaces and the oscillation index of
- * the mean effective stress; at one frame the pore pressure along a line. `poro-solve report` is
+ * settlement, the largest gap between the soil and the water surfaces, the oscillation index of
+ * the mean effective stress and the two-cell pattern index of the pore pressure; at one frame the pore pressure along a line. `poro-solve report` is
  * its command line; docs/report.md gives the definitions with the reasons for them.
  *
  * Typical use:
@@ -38,6 +38,12 @@
  *                positions x - displacement, at the seeding spacing h / particles_per_cell of the
  *                case's first body; NaN where that function finds it undefined (zero stress, as
  *                before gravity acts, or no point with two lattice neighbours).
+ *   pressure_pattern_index  oscillation_index_pattern() (oscillation.h) of the pore pressure over
+ *                the points that carry it (water points in double point, soil points in single
+ *                point), at their reference positions on the same lattice, blocks of one cell
+ *                (particles_per_cell sites): a pattern of period two cells, which the point and
+ *                cell indices score 0 when it is centred on the nodes (docs/numerics.md); NaN
+ *                where undefined (zero pressure everywhere, or no full cell between two others).
  *   line sample  the mean pore pressure of the points that carry it (water points in double
  *                point, soil points in single point) within distance h of the sample; NaN when
  *                none is. A line is a polyline (a curved shear band is followed corner by
@@ -99,6 +105,7 @@ struct report_row {
 	double max_gap;               /* m, soil surface above water surface */
 	double max_gap_x;             /* m, centre of the column of max_gap */
 	double oscillation_index;     /* 1 */
+	double pressure_pattern_index;  /* 1 */
 };
 
 /* A path to sample: the polyline through `vertices` corners, with `samples` points evenly spaced

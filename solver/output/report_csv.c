@@ -31,10 +31,12 @@ static enum poro_status finish(FILE *f, const char *name, struct poro_error *err
 enum poro_status report_frames_write(FILE *f, const char *name, const struct report_row *rows, long count,
 				     struct poro_error *err)
 {
-	fputs("time,toe_x,runout,front_x,bulk_front_x,crest_settlement,max_gap,max_gap_x,oscillation_index\n", f);
+	fputs("time,toe_x,runout,front_x,bulk_front_x,crest_settlement,max_gap,max_gap_x,oscillation_index,"
+	      "pressure_pattern_index\n", f);
 	for (const struct report_row *r = rows; r < rows + count; r++)
 		put(f, (const double[]){r->time, r->toe_x, r->runout, r->front_x, r->bulk_front_x, r->crest_settlement,
-					r->max_gap, r->max_gap_x, r->oscillation_index}, 9, "\n");
+					r->max_gap, r->max_gap_x, r->oscillation_index, r->pressure_pattern_index}, 10,
+		    "\n");
 	return finish(f, name, err);
 }
 

@@ -1,13 +1,17 @@
 /*
  * report_frames.c - the per-frame table of a report (report.h): toe, run-out and slide front,
- * crest settlement, the largest gap between the soil and water surfaces, and the oscillation index
- * of the mean effective stress, from each frame's soil (and water) points. Definitions in report.h and
- * docs/report.md; each quantity is one pass over a frame's points.
+ * crest settlement, the largest gap between the soil and water surfaces, the oscillation index
+ * of the mean effective stress and the two-cell pattern index of the pore pressure, from each
+ * frame's soil (and water) points. Definitions in report.h and docs/report.md; each quantity is
+ * one pass over a frame's points.
  *
  * The oscillation index is oscillation_index() itself (oscillation.h), given a read-only view of
  * the frame's soil points: their reference positions x0 = x - displacement (the seeding lattice
  * it places points on; the subtraction undoes the writer's x - x0 to round-off, far inside the
- * half spacing that floor() in oscillation.c tolerates) and their stress.
+ * half spacing that floor() in oscillation.c tolerates) and their stress. The pattern index is
+ * oscillation_index_pattern() on a view of the points that carry the pore pressure (the water
+ * points in double point, which are seeded on the soil's lattice, and the soil points in single
+ * point), placed the same way.
  */
 #include "report_internal.h"
 
@@ -109,16 +113,16 @@ static void largest_gap(struct report *rep, const double *soil, long ns, const d
 	}
 }
 
-/* The reference positions x0 = x - displacement of the soil points x[n] of a frame (heap, the
- * caller frees). */
-static enum poro_status reference_positions(struct report *rep, long frame, const double *x, long n, double **x0,
-					    struct poro_error *err)
+/* The reference positions x0 = x - displacement of the points x[n] of point set `set` of a frame
+ * (heap, the caller frees). */
+static enum poro_status reference_positions(struct report *rep, long frame, const char *set, const double *x, long n,
+					    double **x0, struct poro_error *err)
 {
 	long rows = 0;
-	enum poro_status st = report_read(rep, frame, "soil", "displacement", 2, x0, &rows, err);
+	enum poro_status st = report_read(rep, frame, set, "displacement", 2, x0, &rows, err);
 	if (!st && rows != n)
-		st = poro_error_set(err, PORO_EIO, "frame %ld of '%s': %ld soil positions but %ld displacements",
-				    frame, rep->path, n, rows);
+		st = poro_error_set(err, PORO_EIO, "frame %ld of '%s': %ld %s positions but %ld displacements",
+				    frame, rep->path, n, set, rows);
 	if (!st)
 		for (long k = 0; k < 2 * n; k++)
 			(*x0)[k] = x[k] - (*x0)[k];
@@ -150,6 +154,35 @@ static enum poro_status oscillation(struct report *rep, long frame, double *x0, 
 	return st;
 }
 
+/* The two-cell pattern index of a frame's pore pressure on the points of `set` at positions x[n]
+ * (x0: their reference positions when already known, else NULL); NaN where
+ * oscillation_index_pattern() finds it undefined. */
+static enum poro_status pressure_pattern(struct report *rep, long frame, const char *set, const double *x,
+					 const double *x0, long n, double *index, struct poro_error *err)
+{
+	double *p = NULL, *own = NULL;
+	long rows = 0;
+	enum poro_status st = x0 ? PORO_OK : reference_positions(rep, frame, set, x, n, &own, err);
+	if (!st)
+		st = report_read(rep, frame, set, "pore_pressure", 1, &p, &rows, err);
+	if (!st && rows != n)
+		st = poro_error_set(err, PORO_EIO, "frame %ld of '%s': %ld %s positions but %ld pore pressures", frame,
+				    rep->path, n, set, rows);
+	if (!st) {
+		const struct particles view = {.n = (idx_t)n, .x0 = (double *)(x0 ? x0 : own)};
+		struct poro_error undefined = {0};
+		st = oscillation_index_pattern(&rep->spec->grid, &view, rep->spacing, rep->particles_per_cell, p, index,
+					       &undefined);
+		if (st == PORO_EINVAL)
+			*index = NAN, st = PORO_OK;
+		else if (st)
+			*err = undefined;
+	}
+	free(p);
+	free(own);
+	return st;
+}
+
 /* One frame's row but for the differences to the first frame (runout, crest_settlement), and the
  * surface height at the crest in *top. */
 static enum poro_status frame_row(struct report *rep, long frame, struct report_row *row, double *top,
@@ -162,7 +195,7 @@ static enum poro_status frame_row(struct report *rep, long frame, struct report_
 	if (!st)
 		st = report_read(rep, frame, "soil", "x", 2, &soil, &ns, err);
 	if (!st)
-		st = reference_positions(rep, frame, soil, ns, &soil0, err);
+		st = reference_positions(rep, frame, "soil", soil, ns, &soil0, err);
 	if (!st) {
 		row->toe_x = front(soil, soil, ns, set->ground + set->tolerance);
 		row->front_x = front(soil, soil0, ns, set->ground + set->tolerance);
@@ -182,6 +215,11 @@ static enum poro_status frame_row(struct report *rep, long frame, struct report_
 		largest_gap(rep, soil, ns, water, nw, row);
 	if (!st)
 		st = oscillation(rep, frame, soil0, ns, &row->oscillation_index, err);
+	if (!st)
+		st = rep->double_point ? pressure_pattern(rep, frame, "water", water, NULL, nw, &row->pressure_pattern_index,
+							  err)
+				       : pressure_pattern(rep, frame, "soil", soil, soil0, ns, &row->pressure_pattern_index,
+							  err);
 	free(soil);
 	free(soil0);
 	free(water);

@@ -15,7 +15,8 @@ struct report {
 	struct case_spec *spec;           /* the case stored in the file */
 	struct report_settings settings;  /* in effect: every field finite */
 	double h;                         /* grid cell_size, m */
-	double spacing;                   /* seeding spacing of the first body, m (oscillation index) */
+	double spacing;                   /* seeding spacing of the first body, m (oscillation indices) */
+	int particles_per_cell;           /* of the first body: the sites of a cell along x and y */
 	int double_point;                 /* the case's formulation has water points */
 	long frames;
 	long columns;                     /* gap columns of width h across the grid */

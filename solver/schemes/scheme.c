@@ -3,13 +3,15 @@
  */
 #include "scheme.h"
 
-#include "semi_implicit.h"
-
 const struct scheme *scheme_of(enum case_scheme kind)
 {
 	switch (kind) {
+	case SCHEME_EXPLICIT:
+		return &explicit_scheme;
+	case SCHEME_IMPLICIT_UPU:
+		return &implicit_upU_scheme;
 	case SCHEME_SEMI_IMPLICIT:
-		return &semi_implicit_scheme;
+		break;
 	}
 	return &semi_implicit_scheme;
 }

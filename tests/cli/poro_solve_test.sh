@@ -149,6 +149,41 @@ rc=$?
 grep -q "^terzaghi: t = 0.01 s" "$tmp/check" && [ -f "$out/result.xdmf" ]
 check run_short_result_readable $(( rc != 0 || $? != 0 )) "terzaghi-error exit $rc: $(cat "$tmp/check")"
 
+# ---- GNU habits: --help and --version exit 0, "--opt=value", options before the file ----------------
+
+"$solve" --help > "$tmp/help" 2> "$tmp/err"
+rc=$?
+grep -q "^usage: poro-solve run CASE.json --out DIR" "$tmp/help" && grep -q "^  3  solver failure" "$tmp/help" && [ ! -s "$tmp/err" ]
+check help_exits_0_on_stdout_with_exit_statuses $(( rc != 0 || $? != 0 )) "exit $rc: $(head -c 300 "$tmp/help" "$tmp/err")"
+version=$("$solve" --version 2>&1)
+rc=$?
+echo "$version" | grep -Eqx "poro-solve [A-Za-z0-9._-]+" && [ "$version" = "$("$solve" version)" ] && [ "$version" != "poro-solve unknown" ]
+check version_exits_0_with_the_build_version $(( rc != 0 || $? != 0 )) "exit $rc: '$version'"
+ok=0
+for c in run validate element report probes version; do
+	"$solve" "$c" --help > "$tmp/help" 2>&1 && grep -q "^usage: poro-solve $c" "$tmp/help" || ok=1
+done
+check every_command_help_exits_0 $ok "$(head -c 300 "$tmp/help")"
+"$solve" 2> "$tmp/err" > /dev/null
+grep -q -- "--checkpoint-wall" "$tmp/err"    # poro-worker reads the usage for it
+check usage_names_checkpoint_wall $? "$(head -c 300 "$tmp/err")"
+"$solve" run --out="$tmp/out_eq" --checkpoint-wall=30 "$tmp/short.json" > /dev/null 2> "$tmp/err"
+rc=$?
+[ -s "$tmp/out_eq/result.h5" ]
+check run_opt_equals_value_before_the_file $(( rc != 0 || $? != 0 )) "exit $rc: $(head -c 300 "$tmp/err")"
+"$solve" probes --job=12 --attempt=3 "$tmp/out_eq/result.h5" --out="$tmp/probes.json" 2> "$tmp/err"
+rc=$?
+[ "$(python3 -c 'import json, sys; d = json.load(open(sys.argv[1])); print(d["job"], d["attempt"])' "$tmp/probes.json" 2>&1)" = "12 3" ]
+check probes_opt_equals_value $(( rc != 0 || $? != 0 )) "exit $rc: $(head -c 300 "$tmp/err")"
+"$solve" run "$tmp/short.json" --out "$tmp/out_bad" --frobnicate > /dev/null 2> "$tmp/err"
+rc=$?
+grep -q "^poro-solve run: unrecognized option '--frobnicate'" "$tmp/err" && [ ! -e "$tmp/out_bad" ]
+check unknown_option_exits_2_naming_it $(( rc != 2 || $? != 0 )) "exit $rc: $(head -c 300 "$tmp/err")"
+"$solve" element "$tmp/short.json" > /dev/null 2> "$tmp/err"
+rc=$?
+grep -q "^poro-solve element: missing --out DIR" "$tmp/err"
+check element_without_out_exits_2_naming_it $(( rc != 2 || $? != 0 )) "exit $rc: $(head -c 300 "$tmp/err")"
+
 # ---- a solver failure: the column falls out of the grid through its free bottom ------------------
 
 derive falls 'c["boundaries"]["bottom"] = {"soil": "free", "water": "free"}

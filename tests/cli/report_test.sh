@@ -11,7 +11,9 @@
 #     pressures within h, computed here from the frame's datasets, and against Terzaghi's pore
 #     pressure (000 Eqs. 84-86) at the sample's depth;
 #   - the table's shape: a header, a row per frame, "nan" where a quantity is undefined (the
-#     oscillation index before any stress, the gap in single point).
+#     oscillation index before any stress, the pressure pattern index before any pressure, the
+#     gap in single point); the pressure pattern index of a column that consolidates in one
+#     dimension near 0.
 # Bad input: exit 4 for a missing file, exit 2 with the subject named for a file that is not a
 # result (text, checkpoint.h5), a rectangle body without --ground, a malformed --line, an unknown
 # option, a value that is not a number, --at outside the run; no output file is left behind.
@@ -58,6 +60,7 @@ tmp = sys.argv[1]
 H_CELL = 0.025                       # the case's cell_size: the line's averaging radius
 Q, K, E, RHO_W, G, HEIGHT = 1.0e4, 1.0e-3, 1.0e7, 1000.0, 9.81, 1.0   # terzaghi.json, nu = 0
 CLOSED_FORM_TOL = 0.01               # of q; measured 0.005, largest 0.25 m below the top (the front at Tv = 0.01)
+PATTERN_NONE = 0.01                  # pressure pattern index of a smooth field; the slope's pattern scores 0.3-0.5
 
 def report(name, ok, why):
     print(("PASS %s" % name) if ok else ("FAIL %s: %s" % (name, why)))
@@ -66,14 +69,20 @@ def numbers(name):
     return [float(v) for v in open("%s/%s" % (tmp, name)).read().split()]
 
 rows = list(csv.reader(open(tmp + "/table.csv")))
-header = ["time", "toe_x", "runout", "front_x", "bulk_front_x", "crest_settlement", "max_gap", "max_gap_x", "oscillation_index"]
+header = ["time", "toe_x", "runout", "front_x", "bulk_front_x", "crest_settlement", "max_gap", "max_gap_x", "oscillation_index",
+          "pressure_pattern_index"]
 table = [dict(zip(header, map(float, r))) for r in rows[1:]]
 report("table_header_and_a_row_per_frame",
-       rows[0] == header and [r["time"] for r in table] == [0.0, 0.005, 0.01] and all(len(r) == 9 for r in rows),
+       rows[0] == header and [r["time"] for r in table] == [0.0, 0.005, 0.01] and all(len(r) == 10 for r in rows),
        "rows %s" % rows)
 report("table_oscillation_nan_before_stress_then_finite",
        math.isnan(table[0]["oscillation_index"]) and all(math.isfinite(r["oscillation_index"]) for r in table[1:]),
        [r["oscillation_index"] for r in table])
+# the column's pore pressure consolidates as in one dimension: nothing varies along x, no pattern
+report("table_pressure_pattern_nan_before_pressure_then_none",
+       math.isnan(table[0]["pressure_pattern_index"]) and
+       all(0.0 <= r["pressure_pattern_index"] < PATTERN_NONE for r in table[1:]),
+       [r["pressure_pattern_index"] for r in table])
 report("table_gap_finite_in_double_point", all(math.isfinite(r["max_gap"]) for r in table),
        [r["max_gap"] for r in table])
 
@@ -120,7 +129,7 @@ EOF
 "$solve" report "$tmp/single/result.h5" --ground 0.5 --crest 0.05 > "$tmp/single.csv" 2> "$tmp/err"
 rc=$?
 [ "$rc" -eq 0 ] && [ "$(wc -l < "$tmp/single.csv")" -eq 4 ] &&
-	head -1 "$tmp/single.csv" | grep -qx "time,toe_x,runout,front_x,bulk_front_x,crest_settlement,max_gap,max_gap_x,oscillation_index" &&
+	head -1 "$tmp/single.csv" | grep -qx "time,toe_x,runout,front_x,bulk_front_x,crest_settlement,max_gap,max_gap_x,oscillation_index,pressure_pattern_index" &&
 	[ "$(cut -d, -f7,8 "$tmp/single.csv" | sort -u)" = "$(printf 'max_gap,max_gap_x\nnan,nan')" ]
 check single_point_table_to_stdout_gap_nan $? "exit $rc: $(head -c 400 "$tmp/single.csv") $(head -c 200 "$tmp/err")"
 "$solve" report "$tmp/single/result.h5" --ground 0.5 --crest 0.05 --line 0.05,0.3,0.05,0.7,3 \
@@ -151,7 +160,7 @@ refused 2 rectangle_body_without_ground_exits_2 "body 'column' is a rectangle" "
 	--out "$tmp/refused.csv"
 refused 2 malformed_line_exits_2_naming_it "malformed line '0,1,2'" "$run/result.h5" "${good[@]}" \
 	--line 0,1,2 --line-out "$tmp/l.csv"
-refused 2 unknown_option_exits_2_naming_it "unknown option '--frobnicate'" "$run/result.h5" "${good[@]}" \
+refused 2 unknown_option_exits_2_naming_it "unrecognized option '--frobnicate'" "$run/result.h5" "${good[@]}" \
 	--frobnicate 1
 refused 2 ground_not_a_number_exits_2 "--ground: 'five' is not a number" "$run/result.h5" --ground five --crest 0.05
 refused 2 at_outside_run_exits_2 "time 5 s is outside the run" "$run/result.h5" "${good[@]}" \

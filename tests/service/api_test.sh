@@ -372,7 +372,8 @@ wait "$submitter"
 code=$(svc_req GET /metrics "$admin")
 grep -q '^poro_jobs{state="succeeded"} 1$' "$SVC_BODY" && grep -q '^poro_claim_latency_seconds_count ' "$SVC_BODY" \
 	&& grep -q '^poro_commit_seconds_bucket' "$SVC_BODY" && grep -q 'poro_http_requests_total{code="404"}' "$SVC_BODY" \
-	&& grep -q '^poro_worker_heartbeat_age_seconds{worker="w1"}' "$SVC_BODY" && grep -q '^poro_job_duration_seconds_count' "$SVC_BODY"
+	&& grep -q '^poro_worker_heartbeat_age_seconds{worker="host-a:4242",user="w1"}' "$SVC_BODY" \
+	&& grep -q '^poro_worker_heartbeat_age_seconds{worker="w1",user="w1"}' "$SVC_BODY" && grep -q '^poro_job_duration_seconds_count' "$SVC_BODY"
 check metrics_prometheus_text $? "status $code: $(head -c 400 "$SVC_BODY")"
 [ "$(svc_req GET /metrics "$worker")" = 200 ]
 check metrics_worker_token_200 $? "worker token refused"

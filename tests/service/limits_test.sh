@@ -194,8 +194,11 @@ wait "${clients[@]}"
 acknowledged=$(for i in $(seq 8); do json '["id"]' < "$SVC_TMP/small.$i" 2>/dev/null; done | sort -n | tr '\n' ' ')
 answers=$(sort "$SVC_TMP/oom.txt" | uniq -c | tr -s ' \n' ' ')
 echo "INFO out of memory (200 MB address space): answers $answers; acknowledged jobs: $acknowledged"
-for f in "$SVC_TMP"/heavy.* "$SVC_TMP"/small.*; do
+for f in "$SVC_TMP"/heavy.[0-9]* "$SVC_TMP"/small.[0-9]*; do
 	grep -q '"code":"internal"' "$f" && echo "INFO answered 500: $(head -c 300 "$f")"
+	grep -q -e '"id":' -e '"code":"unavailable"' -e '"code":"body_too_' -e '"code":"invalid_case"' \
+		-e '"code":"invalid_request"' -e '"code":"too_many_requests"' "$f" ||
+		echo "INFO an answer other than 201, 413, 422, 429 or 503: $(head -c 300 "$f")"
 done
 kill -0 "$SVC_PID" && ! grep -qv -e '^201$' -e '^413$' -e '^422$' -e '^429$' -e '^503$' "$SVC_TMP/oom.txt"
 check limits_out_of_memory_answered_503 $? "server alive: $(kill -0 "$SVC_PID" 2>/dev/null && echo yes || echo no); answers $answers"

@@ -2,8 +2,9 @@
 # route_coverage.sh - checks schemas/openapi.yaml with a real OpenAPI linter (@redocly/cli, pinned
 # in tools/openapi-lint and installed by deploy/deps.sh), then checks that every operation it
 # describes (method and path) was answered at least once during the service tests: tests/run.sh
-# points SVC_ROUTES_LOG at one file that every poro-server started by the tests appends
-# "METHOD ROUTE STATUS MS" to (--access-log). Run after the other service tests.
+# points SVC_ROUTES_LOG at one file that every poro-server started by the tests appends its
+# request lines to (--access-log; logfmt, "... msg=request method=GET route=/v1/jobs status=200
+# ..."). Run after the other service tests.
 #   bash tests/service/route_coverage.sh BUILD_DIR ROUTES_LOG
 set -u
 build=${1:-build}
@@ -40,13 +41,14 @@ if [ ! -s "$log" ]; then
 	exit 1
 fi
 python3 - "$bundle" "$log" <<'PY'
-import json, sys
+import json, re, sys
 spec = json.load(open(sys.argv[1]))
+pair = re.compile(r'([A-Za-z_]+)=("(?:[^"\\]|\\.)*"|\S*)')
 seen = set()
-for line in open(sys.argv[2]):
-    parts = line.split()
-    if len(parts) >= 3:
-        seen.add((parts[0], parts[1]))
+for line in open(sys.argv[2], errors="replace"):
+    f = dict(pair.findall(line))
+    if f.get("msg") == "request" and "status" in f:
+        seen.add((f.get("method"), f.get("route")))
 methods = {"get", "put", "post", "delete", "patch", "head", "options"}
 for path, item in sorted(spec["paths"].items()):
     for method in sorted(m for m in item if m in methods):

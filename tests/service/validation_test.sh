@@ -3,7 +3,9 @@
 # a case of 1000 bad probes is answered 422 with at most CASE_PROBLEMS_MAX (100) problems and the
 # total stated; threads above --max-job-threads is 422 naming /threads and the limit; cases over a
 # limit of docs/case-spec.md "Limits" (the issue's 1.6e9 cells, an end time of 1e12 s, 40,000
-# probes) are 422 naming the limit; a case of 10,000 probes (the limit) is accepted. The server's
+# probes) are 422 naming the limit; a case of 10,000 probes (the limit) is accepted; a valid case's
+# warnings (a friction angle that reads as radians) come back with its 201, and a case without one
+# gets an empty list. The server's
 # peak RSS (VmHWM) and the time of each answer are printed as INFO lines, never asserted; nothing
 # refused is stored. Runs in a few seconds.
 #   bash tests/service/validation_test.sh BUILD_DIR      (from the repository root)
@@ -82,7 +84,7 @@ over_limit cells_1.6e9 'c["grid"]["extent"] = [1000.0, 1000.0]' /case/grid \
 over_limit end_1e12 'c["time"]["end"] = 1e12; c["output"]["frame_interval"] = 0' /case/time/end \
 	"must take at most 1000000000 steps of /time/dt (the case limit), got 1e+16"
 over_limit dt_above_cfl 'c["time"]["dt"] = 2e-3' /case/time/dt \
-	"must be at most 0.000426 s, 1.25 times the soil skeleton's CFL step h / c_p = 0.00034 s (c_p = sqrt((K + 4G/3) / ((1 - n) rho_s)) = 73.42 m/s in body 'column'), got 0.002"
+	"must be at most 0.000426 s, 1.25 times the soil skeleton's CFL step h / c_p = 0.00034 s (c_p = sqrt((K + 4G/3) / ((1 - n) rho_s)) = 73.42 m/s in body 'column'), got 0.002 (or write \"auto\")"
 over_limit probes_40000 \
 	'c["probes"] = [{"name": "p%d" % i, "kind": "pore_pressure", "point": [0.05, 0.5]} for i in range(40000)]' \
 	/case/probes "must list at most 10000 probes (the case limit), got 40000"
@@ -95,5 +97,21 @@ body "$tmp/probes_10000.json" \
 submit "$tmp/probes_10000.json"
 check probes_at_the_limit_accepted $(( code != 201 )) "status $code: $(head -c 300 "$SVC_BODY")"
 peak_rss "10000 probes"
+# ---- a valid case's warnings come back with the job ----------------------------------------------
+body "$tmp/radians.json" 'c["materials"][0].update(model="mohr_coulomb", cohesion=1.2e4, friction_angle=0.38, dilation_angle=0)'
+submit "$tmp/radians.json"
+[ "$code" = 201 ] && [ "$(json '["warnings"][0]["field"]' < "$SVC_BODY")" = /case/materials/0/friction_angle ] &&
+	case $(json '["warnings"][0]["message"]' < "$SVC_BODY") in *"0.38 degrees"*"write 21.77") true ;; *) false ;; esac &&
+	[ "$(json '["warnings"]' < "$SVC_BODY" | python3 -c 'import json, sys; print(len(json.load(sys.stdin)))')" = 1 ]
+check case_warnings_answered_with_the_job $? "status $code: $(head -c 400 "$SVC_BODY")"
+id=$(json '["id"]' < "$SVC_BODY")
+svc_req GET "/v1/jobs/$id" "$alice" > /dev/null
+python3 -c 'import json, sys; sys.exit("warnings" in json.load(sys.stdin))' < "$SVC_BODY"
+check case_warnings_not_stored_with_the_job $? "$(head -c 300 "$SVC_BODY")"
+body "$tmp/no_warning.json" 'c["title"] = "no warning"'
+submit "$tmp/no_warning.json"
+[ "$code" = 201 ] && [ "$(json '["warnings"]' < "$SVC_BODY")" = "[]" ]
+check case_without_warnings_answered_with_an_empty_list $? "status $code: $(head -c 300 "$SVC_BODY")"
+
 svc_req GET /healthz "" > /dev/null
 check server_alive_after_the_submissions $? "healthz did not answer"

@@ -192,6 +192,18 @@ static json_t *text_of(size_t n)
 	return v;
 }
 
+/* A title of n characters U+00E9 (two bytes each in UTF-8). */
+static json_t *accented_text_of(size_t n)
+{
+	char *s = malloc(2 * n + 1);
+	for (size_t i = 0; i < n; i++)
+		s[2 * i] = (char)0xc3, s[2 * i + 1] = (char)0xa9;
+	s[2 * n] = '\0';
+	json_t *v = json_string(s);
+	free(s);
+	return v;
+}
+
 static void test_text_limits(void)
 {
 	char want[256];
@@ -205,11 +217,20 @@ static void test_text_limits(void)
 	expect_refused("name too long refused", doc, want);
 	doc = terzaghi();
 	json_object_set_new(doc, "title", text_of(CASE_TITLE_MAX));
-	expect_valid("title of the most bytes loads", doc);
+	expect_valid("title of the most characters loads", doc);
 	doc = terzaghi();
 	json_object_set_new(doc, "title", text_of(CASE_TITLE_MAX + 1));
-	snprintf(want, sizeof want, "/title: must be at most %d bytes long, got %d", CASE_TITLE_MAX, CASE_TITLE_MAX + 1);
+	snprintf(want, sizeof want, "/title: must be at most %d characters long, got %d", CASE_TITLE_MAX,
+		 CASE_TITLE_MAX + 1);
 	expect_refused("title too long refused", doc, want);
+	/* the schema's maxLength counts characters: 255 accented letters (510 bytes) were refused
+	 * when the limit counted bytes */
+	doc = terzaghi();
+	json_object_set_new(doc, "title", accented_text_of(CASE_TITLE_MAX));
+	expect_valid("title of the most accented characters loads", doc);
+	doc = terzaghi();
+	json_object_set_new(doc, "title", accented_text_of(CASE_TITLE_MAX + 1));
+	expect_refused("title of too many accented characters refused", doc, want);
 }
 
 /* The case on a grid of 1 m cells, nx by ny. */

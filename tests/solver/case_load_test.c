@@ -11,6 +11,7 @@
  * the root, so a relative __FILE__ means the tests run from there too).
  */
 #include "case.h"
+#include "case_json.h"   /* case_read_text */
 #include "element.h"
 #include "stable_dt.h"
 
@@ -191,6 +192,7 @@ static void test_minimal_defaults(const struct case_spec *c)
 	CHECK(f->specific_volume == SPECIFIC_VOLUME_POINT, "default specific volume", "got %d", f->specific_volume);
 	CHECK(c->bodies[0].permeability_law == PERMEABILITY_CONSTANT, "default permeability law", "got %d",
 	      c->bodies[0].permeability_law);
+	CHECK(c->bodies[0].saturated == 1, "a body is saturated by default", "got %d", c->bodies[0].saturated);
 	CHECK(c->fluid.density == 1000 && c->fluid.bulk_modulus == 2.2e9, "default fluid",
 	      "density %g bulk modulus %g", c->fluid.density, c->fluid.bulk_modulus);
 	const double *g = c->gravity.acceleration;
@@ -230,6 +232,13 @@ static void test_full_bodies(const struct case_spec *c)
 	CHECK(w->is_polygon && w->polygon_count == 3 && w->material == 1 && w->polygon[2][0] == 0.45 &&
 	      w->polygon[2][1] == 0.65 && w->permeability_law == PERMEABILITY_KOZENY_CARMAN,
 	      "full polygon body", "polygon body differs");
+	const struct edit dry = { "/bodies/1/saturated", "false" };
+	char *text = edited(full_case, &dry, 1);
+	struct case_spec *d = load_valid("case with a dry body loads", text);
+	CHECK(d && d->bodies[0].saturated && !d->bodies[1].saturated, "a dry body reads as such", "saturated %d and %d",
+	      d ? d->bodies[0].saturated : -1, d ? d->bodies[1].saturated : -1);
+	case_destroy(&d);
+	free(text);
 	CHECK(w->min[0] == 0.2 && w->min[1] == 0.3 && w->max[0] == 0.9 && w->max[1] == 0.65,
 	      "polygon bounding box", "[%g, %g] to [%g, %g]", w->min[0], w->min[1], w->max[0], w->max[1]);
 }
@@ -337,6 +346,15 @@ static void test_wrong_types(void)
 		       "/gravity/acceleration: expected 2 numbers, got 3");
 	expect_invalid("string in a vector", "/grid/origin/1", "\"0\"",
 		       "/grid/origin/1: expected a number, got string");
+	expect_invalid("number for saturated", "/bodies/1/saturated", "0",
+		       "/bodies/1/saturated: expected a boolean, got number");
+	{
+		const struct edit e[] = { { "/bodies/1/saturated", "false" },
+					  { "/formulation/pressure_projection", "\"consistent\"" } };
+		const char *needles[] = { "/bodies/1/saturated: false needs /formulation/pressure_projection \"laplacian\"",
+					  NULL };
+		expect_invalid_edits("dry body with the consistent projection", full_case, e, 2, needles);
+	}
 	expect_invalid("fraction for an integer", "/bodies/0/particles_per_cell", "2.5",
 		       "/bodies/0/particles_per_cell: expected an integer, got 2.5");
 	expect_invalid("array item not an object", "/probes/1", "7",
@@ -506,7 +524,7 @@ static void test_out_of_range(void)
 		       "0123456789012345678901234567890123456789012345678901234567890123456789"
 		       "0123456789012345678901234567890123456789012345678901234567890123456789"
 		       "0123456789012345678901234567890123456789012345678901234567890123456789" "\"",
-		       "/title: must be at most 255 bytes long, got 280");
+		       "/title: must be at most 255 characters long, got 280");
 }
 
 static void test_unknown_keys(void)
@@ -522,6 +540,32 @@ static void test_unknown_keys(void)
 		       "/probes/0/component: unknown key");
 	expect_invalid("key escaped in the pointer", "/materials/0/a~b", "1",
 		       "/materials/0/a~0b: unknown key");
+}
+
+/* "$schema" names the JSON Schema for editors (case.schema.json, element.schema.json): any string, in a simulation
+ * case and in an element case alike; anything else is refused. It was an unknown key. */
+static void test_schema_location(void)
+{
+	static const char *element =
+		"{\"$schema\": \"../../schemas/element.schema.json\", \"schema\": \"poro-element/1\","
+		" \"material\": {\"model\": \"linear_elastic\", \"youngs_modulus\": 2.5e7, \"poisson_ratio\": 0.25},"
+		" \"test\": \"drained\", \"confining_pressure\": 1.25e5, \"axial_strain\": -0.0125, \"steps\": 10}";
+	const struct edit e = { "/$schema", "\"https://example.org/poro/case.schema.json\"" };
+	char *text = edited(minimal_case, &e, 1);
+	struct case_spec *c = load_valid("case with $schema loads", text);
+	case_destroy(&c);
+	free(text);
+	expect_invalid("$schema not a string", "/$schema", "3", "/$schema: expected a string, got number");
+	struct element_case ec;
+	struct poro_error err = { 0 };
+	enum poro_status st = element_case_load_string(element, &ec, &err);
+	CHECK(st == PORO_OK, "element case with $schema loads", "status %d: %s", st, err.message);
+	const struct edit bad = { "/$schema", "{}" };
+	text = edited(element, &bad, 1);
+	st = element_case_load_string(text, &ec, &err);
+	CHECK(st == PORO_EINVAL && strstr(err.message, "/$schema: expected a string, got object"),
+	      "element case with a $schema object refused", "status %d: %s", st, err.message);
+	free(text);
 }
 
 static void test_references_and_geometry(void)
@@ -789,6 +833,157 @@ static void test_stable_dt(const char *root)
 	case_destroy(&c);
 }
 
+/* The explicit scheme's keys (case_formulation.c): each refused with its pointer, and a valid
+ * explicit case read with every key (002 §4.1's column, cases/terzaghi_002.json). */
+static void test_explicit_scheme(const char *root)
+{
+	char path[512];
+	snprintf(path, sizeof path, "%stests/cases/terzaghi_002.json", root);
+	char *base = NULL;
+	struct poro_error err = {0};
+	if (case_read_text(path, &base, &err)) {
+		CHECK(0, "explicit case readable", "%s", err.message);
+		return;
+	}
+	const struct {
+		const char *name, *pointer, *value, *needle;
+	} bad[] = {
+		{"explicit scheme is single point", "/formulation/phases", "\"double_point\"",
+		 "/formulation/phases: the \"explicit\" scheme is single point"},
+		{"semi-implicit key under explicit", "/formulation/drag_in_correction", "true",
+		 "/formulation/drag_in_correction: applies to the \"semi_implicit\" scheme only, not to \"explicit\""},
+		{"unknown smoothing", "/formulation/strain_rate_smoothing", "\"cell\"",
+		 "/formulation/strain_rate_smoothing: must be one of 'cell_average', 'none'"},
+		{"unknown drag", "/formulation/drag", "\"lumped\"", "/formulation/drag: must be one of"},
+		{"basis without projection", "/formulation/pressure_rate_basis", "\"linear\"", NULL},
+		{"dt neither number nor auto", "/time/dt", "\"fast\"",
+		 "/time/dt: expected a number or \"auto\", got \"fast\""},
+		{"dt above the critical step", "/time/dt", "1e-4", "h / c_fast"},
+		{"initial pore pressure not a number", "/bodies/0/initial_pore_pressure", "\"1e4\"",
+		 "/bodies/0/initial_pore_pressure: expected a number, got string"},
+		{"sinusoid start before 0", "/loads/0/time_function",
+		 "{\"kind\": \"sinusoid\", \"frequency\": 2.5, \"amplitude\": 1, \"start\": -0.1}",
+		 "/loads/0/time_function/start: must be >= 0"},
+		{"drained face with held water", "/boundaries/bottom", "{\"soil\": \"fixed\", \"water\": \"slip\", "
+		 "\"drainage\": \"drained\"}", "/boundaries/bottom/drainage: \"drained\" needs \"water\": \"free\""},
+		{"plate under explicit", "/boundaries/top", "{\"soil\": \"plate\", \"water\": \"plate\", "
+		 "\"plate\": {\"force\": 1000}}", "/boundaries/top/soil: \"plate\" applies to the \"semi_implicit\" scheme only"},
+		{"cavitation under explicit", "/fluid/cavitation_pressure", "-1e5",
+		 "/fluid/cavitation_pressure: applies to the \"semi_implicit\" scheme only"},
+	};
+	for (size_t i = 0; i < sizeof bad / sizeof *bad; i++) {
+		struct edit e[2] = {{bad[i].pointer, bad[i].value}, {"/formulation/pressure_rate_projection", "\"none\""}};
+		const char *needles[] = {bad[i].needle ? bad[i].needle
+						       : "/formulation/pressure_rate_basis: needs /formulation/pressure_rate_projection",
+					 NULL};
+		expect_invalid_edits(bad[i].name, base, e, bad[i].needle ? 1 : 2, needles);
+	}
+	/* an explicit key under the semi-implicit scheme */
+	const struct edit semi[] = {{"/formulation", "{\"scheme\": \"semi_implicit\", \"phases\": \"single_point\", "
+				     "\"drag\": \"explicit\"}"}};
+	const char *semi_needle[] = {"/formulation/drag: applies to the \"explicit\" scheme only, not to \"semi_implicit\"",
+				     NULL};
+	expect_invalid_edits("explicit key under semi-implicit", base, semi, 1, semi_needle);
+	const struct edit all[] = {{"/formulation", "{\"scheme\": \"explicit\", \"phases\": \"single_point\", "
+				    "\"shape\": \"gimp\", \"strain_rate_smoothing\": \"none\", \"pressure_rate_projection\": "
+				    "\"multi_field\", \"pressure_rate_basis\": \"linear\", \"drag\": \"explicit\", "
+				    "\"flip_fraction\": 0.95}"}, {"/time/dt", "\"auto\""}};
+	char *text = edited(base, all, 2);
+	struct case_spec *c = load_valid("explicit case with every key", text);
+	CHECK(c && c->formulation.scheme == SCHEME_EXPLICIT && c->formulation.shape == SHAPE_GIMP &&
+	      c->formulation.strain_rate_smoothing == STRAIN_RATE_SMOOTHING_NONE &&
+	      c->formulation.pressure_rate_projection == PRESSURE_RATE_MULTI_FIELD &&
+	      c->formulation.pressure_rate_basis == PRESSURE_RATE_BASIS_LINEAR && c->formulation.drag == DRAG_EXPLICIT &&
+	      c->time.dt_auto && c->time.dt > 0 && c->bodies[0].initial_pore_pressure == 1e4,
+	      "explicit keys read", "case %p", (void *)c);
+	case_destroy(&c);
+	free(text);
+	free(base);
+}
+
+/* The implicit u-p-U scheme's keys (case_formulation.c): each refused with its pointer, and a
+ * valid implicit case read with every key (cases/terzaghi_001.json). */
+static void test_implicit_scheme(const char *root)
+{
+	char path[512];
+	snprintf(path, sizeof path, "%stests/cases/terzaghi_001.json", root);
+	char *base = NULL;
+	struct poro_error err = {0};
+	if (case_read_text(path, &base, &err)) {
+		CHECK(0, "implicit case readable", "%s", err.message);
+		return;
+	}
+	const struct {
+		const char *name, *pointer, *value, *needle;
+	} bad[] = {
+		{"implicit scheme is single point", "/formulation/phases", "\"double_point\"",
+		 "/formulation/phases: the \"implicit_upU\" scheme is single point"},
+		{"explicit key under implicit", "/formulation/drag", "\"implicit\"",
+		 "/formulation/drag: applies to the \"explicit\" scheme only, not to \"implicit_upU\""},
+		{"APIC under implicit", "/formulation/velocity_update", "\"apic\"",
+		 "/formulation/velocity_update: the \"implicit_upU\" scheme moves its points' velocities by Newmark"},
+		{"PIC blend under implicit", "/formulation/flip_fraction", "0.5",
+		 "/formulation/flip_fraction: the \"implicit_upU\" scheme moves its points' velocities by Newmark"},
+		{"F-bar under implicit", "/formulation/soil_stabilisation", "\"fbar\"",
+		 "/formulation/soil_stabilisation: must be one of 'none', 'bbar'"},
+		{"Newmark beta below stability", "/formulation/newmark_beta", "0.2",
+		 "/formulation/newmark_beta: with newmark_gamma 0.5 must be at least 0.25"},
+		{"Newmark gamma above 1", "/formulation/newmark_gamma", "1.5", "/formulation/newmark_gamma: must be"},
+		{"tolerance of 1", "/formulation/newton_tolerance", "1", "/formulation/newton_tolerance: must be"},
+		{"no iterations", "/formulation/newton_max_iterations", "0", "/formulation/newton_max_iterations: must be"},
+		{"unknown recovery", "/formulation/pressure_recovery", "\"spr\"",
+		 "/formulation/pressure_recovery: must be one of 'mlsa_patch', 'mlsa_nodal', 'none'"},
+		{"unknown mass matrix", "/formulation/mass_matrix", "\"diagonal\"",
+		 "/formulation/mass_matrix: must be one of 'consistent', 'lumped'"},
+		{"auto dt under implicit", "/time/dt", "\"auto\"", "/time/dt: \"auto\" has no meaning for the \"implicit_upU\""},
+		{"B-bar without uGIMP", "/formulation/shape", "\"linear\"",
+		 "/formulation/soil_stabilisation: \"bbar\" samples uGIMP at the cell centres"},
+		{"grain bulk modulus not positive", "/fluid/grain_bulk_modulus", "0", "/fluid/grain_bulk_modulus: must be"},
+		{"consistent tangent on a finite-strain model", "/formulation/tangent", "\"consistent\"", NULL},
+	};
+	for (size_t i = 0; i < sizeof bad / sizeof *bad; i++) {
+		/* the last: a finite-strain material beside the consistent tangent */
+		struct edit e[2] = {{bad[i].pointer, bad[i].value},
+				    {"/materials/0", "{\"name\": \"soil\", \"model\": \"hencky\", \"density\": 2650, "
+				     "\"youngs_modulus\": 1e7, \"poisson_ratio\": 0.0}"}};
+		const char *needles[] = {bad[i].needle ? bad[i].needle
+						       : "/materials/0: material 'soil' is finite strain: /formulation/tangent",
+					 NULL};
+		expect_invalid_edits(bad[i].name, base, e, bad[i].needle ? 1 : 2, needles);
+	}
+	const struct edit semi[] = {{"/formulation", "{\"scheme\": \"semi_implicit\", \"newmark_beta\": 0.3}"}};
+	const char *semi_needle[] = {"/formulation/newmark_beta: applies to the \"implicit_upU\" scheme only", NULL};
+	expect_invalid_edits("implicit key under semi-implicit", base, semi, 1, semi_needle);
+	const struct edit grain[] = {{"/formulation", "{\"scheme\": \"semi_implicit\"}"},
+				     {"/fluid/grain_bulk_modulus", "1e10"}};
+	const char *grain_needle[] = {"/fluid/grain_bulk_modulus: applies to the \"implicit_upU\" scheme only", NULL};
+	expect_invalid_edits("grain bulk modulus under semi-implicit", base, grain, 2, grain_needle);
+	const struct edit all[] = {{"/formulation", "{\"scheme\": \"implicit_upU\", \"phases\": \"single_point\", "
+				    "\"shape\": \"gimp\", \"soil_stabilisation\": \"bbar\", \"newmark_beta\": 0.3025, "
+				    "\"newmark_gamma\": 0.6, \"tangent\": \"consistent\", \"newton_tolerance\": 1e-8, "
+				    "\"newton_max_iterations\": 20, \"pressure_recovery\": \"mlsa_nodal\", "
+				    "\"mass_matrix\": \"lumped\"}"}, {"/fluid/grain_bulk_modulus", "1e10"}};
+	char *text = edited(base, all, 2);
+	struct case_spec *c = load_valid("implicit case with every key", text);
+	const struct case_formulation *f = c ? &c->formulation : NULL;
+	CHECK(c && f->scheme == SCHEME_IMPLICIT_UPU && f->soil_stabilisation == STABILISATION_BBAR &&
+	      f->newmark_beta == 0.3025 && f->newmark_gamma == 0.6 && f->tangent == NEWTON_TANGENT_CONSISTENT &&
+	      f->newton_tolerance == 1e-8 && f->newton_max_iterations == 20 &&
+	      f->pressure_recovery == PRESSURE_RECOVERY_MLSA_NODAL && f->mass_matrix == MASS_MATRIX_LUMPED &&
+	      c->fluid.grain_bulk_modulus == 1e10, "implicit keys read", "case %p", (void *)c);
+	case_destroy(&c);
+	free(text);
+	/* without phases the scheme's single point is the default */
+	const struct edit bare[] = {{"/formulation", "{\"scheme\": \"implicit_upU\", \"shape\": \"gimp\"}"}};
+	text = edited(base, bare, 1);
+	c = load_valid("implicit case without phases", text);
+	CHECK(c && c->formulation.phases == PHASES_SINGLE_POINT && c->formulation.soil_stabilisation == STABILISATION_BBAR,
+	      "implicit defaults: single point, B-bar", "case %p", (void *)c);
+	case_destroy(&c);
+	free(text);
+	free(base);
+}
+
 int main(void)
 {
 	char root[256];
@@ -801,6 +996,7 @@ int main(void)
 	test_wrong_types();
 	test_out_of_range();
 	test_unknown_keys();
+	test_schema_location();
 	test_references_and_geometry();
 	test_missing_required();
 	test_duplicates();
@@ -809,5 +1005,7 @@ int main(void)
 	test_shipped_cases(root);
 	test_documented_example(root);
 	test_stable_dt(root);
+	test_explicit_scheme(root);
+	test_implicit_scheme(root);
 	HARNESS_EXIT();
 }

@@ -153,9 +153,12 @@ static double brute_bulk_front(const struct particles *s)
 }
 
 /* Writes dir/result.h5 of the body `geometry` in `phases`; the oscillation index of each frame's
- * soil, straight from oscillation_index(), into direct[FRAMES] (NAN where undefined), and its bulk
- * front by brute force into bulk[FRAMES]. */
-static int write_synthetic(const char *dir, const char *phases, const char *geometry, double *direct, double *bulk)
+ * soil, straight from oscillation_index(), into direct[FRAMES] (NAN where undefined), the
+ * two-cell pattern index of the pore pressure on the points that carry it, straight from
+ * oscillation_index_pattern(), into pattern[FRAMES], and its bulk front by brute force into
+ * bulk[FRAMES]. */
+static int write_synthetic(const char *dir, const char *phases, const char *geometry, double *direct,
+			   double *pattern, double *bulk)
 {
 	char json[4096];
 	snprintf(json, sizeof json, case_format, phases, geometry);
@@ -177,6 +180,9 @@ static int write_synthetic(const char *dir, const char *phases, const char *geom
 		struct poro_error undefined = {0};
 		if (oscillation_index(&c->grid, &soil, SPACING, &direct[k], &undefined))
 			direct[k] = NAN;
+		const struct particles *carrier = double_point ? &water : &soil;
+		if (oscillation_index_pattern(&c->grid, carrier, SPACING, PPC, carrier->pressure, &pattern[k], &undefined))
+			pattern[k] = NAN;
 		struct output_frame f = {k * FRAME_DT, k, &soil, double_point ? &water : NULL};
 		rc = output_frame_write(o, &f, &err) ? -1 : 0;
 	}
@@ -210,9 +216,8 @@ static void check_settings(const struct report *rep, const char *label)
 	      CREST, s->tolerance, TOLERANCE);
 }
 
-static void check_rows(const struct report_row *r, long count, const double *direct, const double *bulk,
-		       int double_point,
-		       const char *label)
+static void check_rows(const struct report_row *r, long count, const double *direct, const double *pattern,
+		       const double *bulk, int double_point, const char *label)
 {
 	char name[128];
 	const double toe[FRAMES] = {TOE0, TOE0 + DX, LIFTED_X, TOE0 + DX};
@@ -265,6 +270,17 @@ static void check_rows(const struct report_row *r, long count, const double *dir
 	snprintf(name, sizeof name, "%s_oscillation_index_of_checkerboard_near_2A_over_P", label);
 	CHECK(bounded, name, "%.6f, want within [%.6f, %.6f]", r[1].oscillation_index, 2 * P_AMP / (P_MEAN + P_AMP),
 	      2 * P_AMP / (P_MEAN - P_AMP));
+
+	/* the pore pressure's pattern index: oscillation_index_pattern() of the carriers (the sign the
+	 * file stores does not change it), 0 for the constant pressure of frames 2-3 */
+	same = count == FRAMES;
+	for (long k = 0; same && k < FRAMES; k++)
+		same &= r[k].pressure_pattern_index == pattern[k] || (isnan(r[k].pressure_pattern_index) && isnan(pattern[k]));
+	snprintf(name, sizeof name, "%s_pressure_pattern_index_is_oscillation_h_of_the_carriers", label);
+	CHECK(same && r[2].pressure_pattern_index == 0.0 && r[3].pressure_pattern_index == 0.0, name,
+	      "report %.17g %.17g %.17g %.17g, oscillation_index_pattern() %.17g %.17g %.17g %.17g",
+	      r[0].pressure_pattern_index, r[1].pressure_pattern_index, r[2].pressure_pattern_index,
+	      r[3].pressure_pattern_index, pattern[0], pattern[1], pattern[2], pattern[3]);
 }
 
 /* ---- the line ------------------------------------------------------------------------------------ */
@@ -387,9 +403,9 @@ static enum poro_status open_and_read_frames(const char *path, struct report **r
 
 static void check_synthetic(const char *dir, const char *phases)
 {
-	double direct[FRAMES], bulk[FRAMES];
+	double direct[FRAMES], pattern[FRAMES], bulk[FRAMES];
 	char path[256];
-	if (write_synthetic(dir, phases, slope_polygon, direct, bulk)) {
+	if (write_synthetic(dir, phases, slope_polygon, direct, pattern, bulk)) {
 		CHECK(0, phases, "cannot write the synthetic result");
 		return;
 	}
@@ -407,7 +423,7 @@ static void check_synthetic(const char *dir, const char *phases)
 		return;
 	}
 	check_settings(rep, phases);
-	check_rows(rows, count, direct, bulk, !strcmp(phases, "double_point"), phases);
+	check_rows(rows, count, direct, pattern, bulk, !strcmp(phases, "double_point"), phases);
 	check_line(rep, path, !strcmp(phases, "double_point") ? "water" : "soil", phases);
 
 	/* the CSV: a header, one line per frame, NaN as "nan" (frame 0 has no stress) */
@@ -421,9 +437,10 @@ static void check_synthetic(const char *dir, const char *phases)
 	for (char *p = text; p && *p; p++)
 		lines += *p == '\n';
 	snprintf(name, sizeof name, "%s_csv_header_rows_and_nan", phases);
-	const char *head = "time,toe_x,runout,front_x,bulk_front_x,crest_settlement,max_gap,max_gap_x,oscillation_index\n0,1.975,0,1.975,";
+	const char *head = "time,toe_x,runout,front_x,bulk_front_x,crest_settlement,max_gap,max_gap_x,oscillation_index,"
+			   "pressure_pattern_index\n0,1.975,0,1.975,";
 	CHECK(!st && text && lines == FRAMES + 1 && !strncmp(text, head, strlen(head)) &&
-	      strstr(text, ",nan\n"), name, "status %d, %d lines:\n%s", st, lines, text ? text : "(unreadable)");
+	      strstr(text, ",nan,"), name, "status %d, %d lines:\n%s", st, lines, text ? text : "(unreadable)");
 	free(text);
 	free(rows);
 	report_close(&rep);
@@ -523,8 +540,8 @@ static void check_errors(const char *dir, const char *polygon_dir)
 	      "text_file_is_einval_not_a_result_file", "status %d: %s", st, err.message);
 	check_short_datasets(dir, harness_join(path, sizeof path, polygon_dir, "result.h5"));
 
-	double direct[FRAMES], bulk[FRAMES];
-	if (write_synthetic(dir, "single_point", block_rectangle, direct, bulk))
+	double direct[FRAMES], pattern[FRAMES], bulk[FRAMES];
+	if (write_synthetic(dir, "single_point", block_rectangle, direct, pattern, bulk))
 		CHECK(0, "rectangle_result_written", "cannot write");
 	harness_join(path, sizeof path, dir, "result.h5");
 	st = report_open(&rep, path, &set, &err);

@@ -36,7 +36,7 @@ static void check_kind(enum case_shape kind, double lambda, const char *label)
 	const idx_t cells = 7;
 	const double h = 0.0371, inv_h = 1.0 / h;
 	const int S = shape_support(kind);
-	double worst_sum = 0, worst_grad = 0, worst_fd = 0, min_w = 1, worst_lin = 0, worst_dlin = 0;
+	double worst_sum = 0, worst_grad = 0, worst_fd = 0, min_w = 1, worst_lin = 0, worst_dlin = 0, worst_clipped = 0;
 	int out_of_range = 0;
 	for (int k = 0; k < SAMPLES; k++) {
 		/* half the samples inside the two cells next to either edge, where the edge pieces live */
@@ -54,21 +54,31 @@ static void check_kind(enum case_shape kind, double lambda, const char *label)
 		worst_sum = fmax(worst_sum, fabs(sum - 1));
 		worst_grad = fmax(worst_grad, fabs(gsum) * h);
 		/* linear field u = x (in cells): sum S_a (i0 + a) = xi, sum dS_a (i0 + a) = 1 / h; uGIMP
-		 * gives the mean of x over its domain, the domain's centre, which moves with xi at half
-		 * the rate where one end is clipped at an edge (xi itself wherever the domain is inside) */
+		 * gives the mean of x over its domain, the domain's centre (xi itself wherever the domain
+		 * is inside), and the mean of its gradient, 1 / h, clipped or not (shape.c) */
 		double lin = 0, dlin = 0, centre = xi, dcentre = 1;
+		const int clipped = kind == SHAPE_GIMP && lambda > 0 && (xi - lambda <= 0 || xi + lambda >= cells);
 		if (kind == SHAPE_GIMP && lambda > 0) {
 			const double lo = fmax(xi - lambda, 0), hi = fmin(xi + lambda, (double)cells);
 			centre = 0.5 * (lo + hi);
-			dcentre = 0.5 * ((xi - lambda > 0) + (xi + lambda < cells));
 		}
 		for (int a = 0; a < S; a++)
 			lin += w[a] * (double)(i0 + a), dlin += dw[a] * (double)(i0 + a);
 		worst_lin = fmax(worst_lin, fabs(lin - centre) / cells);
 		worst_dlin = fmax(worst_dlin, fabs(dlin * h - dcentre));
+		/* uGIMP's gradient weight where the domain is clipped is the mean of the hat's gradient
+		 * over the clipped domain, (N(b) - N(a)) / (b - a), not the derivative of the weight */
+		if (clipped) {
+			const double lo = fmax(xi - lambda, 0), hi = fmin(xi + lambda, (double)cells);
+			for (int a = 0; a < S; a++) {
+				const double node = (double)(i0 + a);
+				const double mean = (fmax(0, 1 - fabs(hi - node)) - fmax(0, 1 - fabs(lo - node))) / (hi - lo);
+				worst_clipped = fmax(worst_clipped, fabs(mean - dw[a] * h));
+			}
+		}
 		/* finite difference of node i0+a's weight in x (in metres) */
 		const double eps = 1e-6;
-		if (xi > eps && xi < cells - eps && !near_a_join(kind, lambda, xi)) {
+		if (xi > eps && xi < cells - eps && !near_a_join(kind, lambda, xi) && !clipped) {
 			for (int a = 0; a < S; a++) {
 				double wp[SHAPE_SUPPORT_MAX], wm[SHAPE_SUPPORT_MAX], d[SHAPE_SUPPORT_MAX];
 				idx_t ip, im;
@@ -92,6 +102,12 @@ static void check_kind(enum case_shape kind, double lambda, const char *label)
 	CHECK(worst_grad < 1e-13, name, "max |sum dS| h = %.3e", worst_grad);
 	snprintf(name, sizeof name, "%s_gradient_matches_finite_difference", label);
 	CHECK(worst_fd < 1e-6, name, "max error %.3e", worst_fd);
+	if (kind == SHAPE_GIMP && lambda > 0) {
+		printf("INFO %s: clipped domains' gradient weights against the mean hat gradient: %.2e\n", label,
+		       worst_clipped);
+		snprintf(name, sizeof name, "%s_clipped_gradient_is_mean_gradient", label);
+		CHECK(worst_clipped < 1e-14, name, "max error %.3e", worst_clipped);
+	}
 	snprintf(name, sizeof name, "%s_reproduces_linear_fields", label);
 	CHECK(worst_lin < 1e-14 && worst_dlin < 1e-13, name, "value error %.3e, gradient error %.3e", worst_lin, worst_dlin);
 	snprintf(name, sizeof name, "%s_non_negative", label);
@@ -114,6 +130,65 @@ static void check_kind(enum case_shape kind, double lambda, const char *label)
 	snprintf(name, sizeof name, "%s_outside_rejected", label);
 	CHECK(weights_1d(kind, lambda, -1e-9, cells, inv_h, &i0, w, dw) == -1 &&
 	      weights_1d(kind, lambda, cells + 1e-9, cells, inv_h, &i0, w, dw) == -1, name, "a point outside was accepted");
+}
+
+/* uGIMP against brute force: the mean of the hat and of its gradient over the point's domain
+ * [xi - lambda, xi + lambda] clipped to the grid, by the midpoint rule on QUADRATURE_SAMPLES
+ * sub-intervals, at random points inside and next to the edges and random half widths. */
+#define QUADRATURE_SAMPLES 20000
+static void check_gimp_brute_force(void)
+{
+	const idx_t cells = 5;
+	const double inv_h = 1.0 / 0.0437;
+	double worst = 0, worst_grad = 0;
+	for (int k = 0; k < 400; k++) {
+		const double lambda = rnd(0.01, 0.5), xi = k % 2 ? rnd(0, 1) : rnd(0, (double)cells);
+		const double a = fmax(xi - lambda, 0), b = fmin(xi + lambda, (double)cells);
+		double w[SHAPE_SUPPORT_MAX], dw[SHAPE_SUPPORT_MAX];
+		idx_t i0;
+		shape_1d_gimp(xi, lambda, cells, inv_h, &i0, w, dw);
+		for (int n = 0; n < 3; n++) {
+			const double node = (double)(i0 + n);
+			double mean = 0, mean_grad = 0;
+			for (int j = 0; j < QUADRATURE_SAMPLES; j++) {
+				const double x = a + (j + 0.5) * (b - a) / QUADRATURE_SAMPLES, d = x - node;
+				mean += fmax(0, 1 - fabs(d)) / QUADRATURE_SAMPLES;
+				mean_grad += (fabs(d) < 1 ? (d < 0 ? 1.0 : -1.0) : 0.0) / QUADRATURE_SAMPLES;
+			}
+			worst = fmax(worst, fabs(w[n] - mean));
+			worst_grad = fmax(worst_grad, fabs(dw[n] / inv_h - mean_grad));
+		}
+	}
+	printf("INFO gimp against the midpoint rule (%d samples): weights %.2e, gradients h %.2e\n", QUADRATURE_SAMPLES,
+	       worst, worst_grad);
+	CHECK(worst < 1e-8 && worst_grad < 1e-3, "gimp_matches_brute_force_means", "weights %.3e gradients %.3e", worst,
+	      worst_grad);
+}
+
+/* uGIMP next to a wall: under a uniform stress sigma the nodal forces -sigma sum_p V_p dS_I/dx of
+ * rows of points seeded h/2 apart from the wall (2 points per cell, half width h/4, the first
+ * domain touching the wall) are -sigma on the wall node and 0 on every other node, so a wall
+ * condition takes the whole reaction; the derivative of the clipped weight gave -0.75 and -0.25. */
+static void check_gimp_wall_row(void)
+{
+	const idx_t cells = 6;
+	const double h = 0.0437, inv_h = 1.0 / h, lambda = 0.25;
+	double force[8] = {0};
+	for (int k = 0; k < 2 * (int)cells; k++) {
+		const double xi = 0.25 + 0.5 * k;
+		double w[SHAPE_SUPPORT_MAX], dw[SHAPE_SUPPORT_MAX];
+		idx_t i0;
+		shape_1d_gimp(xi, lambda, cells, inv_h, &i0, w, dw);
+		for (int a = 0; a < 3; a++)
+			force[i0 + a] -= 0.5 * h * dw[a];   /* V = h / 2 per unit height, sigma = 1 */
+	}
+	double worst_inner = 0;
+	for (idx_t I = 1; I < cells; I++)
+		worst_inner = fmax(worst_inner, fabs(force[I]));
+	printf("INFO gimp wall row: forces under a unit stress: wall nodes %.6f and %.6f, largest inner %.2e\n",
+	       force[0], force[cells], worst_inner);
+	CHECK(fabs(force[0] - 1.0) < 1e-14 && fabs(force[cells] + 1.0) < 1e-14 && worst_inner < 1e-14,
+	      "gimp_wall_row_takes_whole_reaction", "wall %.6f / %.6f, inner %.3e", force[0], force[cells], worst_inner);
 }
 
 /* 2-D: the tensor product keeps both properties at random points of a whole grid. */
@@ -243,6 +318,8 @@ int main(void)
 	check_kind(SHAPE_GIMP, 0.0, "gimp_zero_width");
 	check_cubic_closed_form();
 	check_gimp_closed_form();
+	check_gimp_wall_row();
+	check_gimp_brute_force();
 	check_2d(SHAPE_LINEAR, "linear");
 	check_2d(SHAPE_QUADRATIC_BSPLINE, "quadratic_bspline");
 	check_2d(SHAPE_CUBIC_BSPLINE, "cubic_bspline");

@@ -13,6 +13,7 @@
  */
 #include <string.h>
 
+#include "../case_file.h"
 #include "../harness.h"
 #include "case.h"
 #include "poro.h"
@@ -20,15 +21,6 @@
 #include "step_health.h"
 
 #define CASES "tests/cases/"
-
-static struct case_spec *load(const char *file)
-{
-	struct case_spec *c = NULL;
-	struct poro_error err = {0};
-	if (case_load_file(file, &c, &err))
-		printf("INFO cannot load %s: %s\n", file, err.message);
-	return c;
-}
 
 /* Steps c up to steps times; returns the step that failed (0: none) and copies the message. */
 static long run(const struct case_spec *c, long steps, char *message, size_t size, int *warned)
@@ -56,7 +48,7 @@ static long run(const struct case_spec *c, long steps, char *message, size_t siz
 
 static void test_load_strain(void)
 {
-	struct case_spec *c = load(CASES "terzaghi.json");
+	struct case_spec *c = test_case_load(CASES "terzaghi.json");
 	int body = -1;
 	const double strain = c ? step_health_load_strain(c, &body) : 0;
 	CHECK(c && body == 0 && rel_diff(strain, 1e4 / 1e7, 1e-30) < 1e-12, "load strain of the Table 1 column is q / E_oed",
@@ -67,7 +59,7 @@ static void test_load_strain(void)
 static void test_time_step_named(void)
 {
 	static char message[PORO_ERROR_MESSAGE_MAX];
-	struct case_spec *c = load(CASES "terzaghi.json");
+	struct case_spec *c = test_case_load(CASES "terzaghi.json");
 	if (!c)
 		return;
 	struct stable_dt e;
@@ -86,7 +78,7 @@ static void test_time_step_named(void)
 static void test_soft_material_named(void)
 {
 	static char message[PORO_ERROR_MESSAGE_MAX];
-	struct case_spec *c = load(CASES "terzaghi.json");
+	struct case_spec *c = test_case_load(CASES "terzaghi.json");
 	if (!c)
 		return;
 	c->materials[0].youngs_modulus = 1e5;
@@ -104,7 +96,7 @@ static void test_soft_material_named(void)
 static void test_small_strain_warning(void)
 {
 	static char message[PORO_ERROR_MESSAGE_MAX];
-	struct case_spec *c = load(CASES "terzaghi_single_point.json");
+	struct case_spec *c = test_case_load(CASES "terzaghi_single_point.json");
 	if (!c)
 		return;
 	int warned;

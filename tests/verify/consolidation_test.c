@@ -33,6 +33,7 @@
 #define MASS_TOL 1e-12
 
 static int consistent_projection;   /* run columns with formulation.pressure_projection "consistent" */
+static int gimp_shape;              /* with formulation.shape "gimp" */
 static int interpolated_surface;    /* and with formulation.free_surface "interpolated" */
 static int weak_surface;            /* with the formulation of terzaghi_low_permeability.json */
 
@@ -127,6 +128,8 @@ static int run_column(const char *file, double cell_size, double dt, const char 
 		c->time.dt = dt;
 	if (consistent_projection)
 		c->formulation.pressure_projection = PROJECTION_CONSISTENT;
+	if (gimp_shape)
+		c->formulation.shape = SHAPE_GIMP;
 	if (interpolated_surface)
 		c->formulation.free_surface = FREE_SURFACE_INTERPOLATED;
 	if (weak_surface)
@@ -379,6 +382,30 @@ static void check_pressure_stabilisation(void)
 	      "mean sigma'_yy %.4f q with, %.4f q without", stress_on, stress_off);
 }
 
+/* uGIMP (shape.h) on the Table 1 columns, double and single point: within 2% RMS of q at every
+ * Tv. Its gradient weights at the walls used to be the derivative of the clipped weights, which
+ * put a quarter of a wall's reaction on the node next to it, and the single-point column inverted
+ * a corner point at step 45 (docs/numerics.md, "Shape functions at the grid edges"). */
+static void check_gimp(void)
+{
+	const double Tv[4] = {0.1, 0.2, 0.5, 1.0};
+	const char *files[2] = {CASES "terzaghi.json", CASES "terzaghi_single_point.json"};
+	const char *labels[2] = {"double_point", "single_point"};
+	gimp_shape = 1;
+	for (int f = 0; f < 2; f++) {
+		double rms[4] = {0}, drift, grid_err, worst = 0;
+		const int ok = run_column(files[f], 0, 0, NULL, Tv, 4, rms, &drift, &grid_err);
+		for (int i = 0; i < 4; i++) {
+			printf("INFO terzaghi %s gimp Tv=%.1f rms/q=%.5f\n", labels[f], Tv[i], rms[i]);
+			worst = fmax(worst, rms[i]);
+		}
+		char name[96];
+		snprintf(name, sizeof name, "terzaghi_%s_gimp_rms_below_2pct", labels[f]);
+		CHECK(ok && worst <= 0.02, name, "worst rms/q %.5f", worst);
+	}
+	gimp_shape = 0;
+}
+
 /* The consistent projection on the single-point column, with the nodal or the interpolated
  * free-surface condition: errors and their fall with h. */
 static void check_consistent_projection(int interpolated)
@@ -480,5 +507,7 @@ int main(int argc, char **argv)
 	}
 	if (WANT("stabilisation"))
 		check_pressure_stabilisation();
+	if (WANT("gimp"))
+		check_gimp();
 	HARNESS_EXIT();
 }

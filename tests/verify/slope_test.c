@@ -20,6 +20,16 @@
  * band at the paper's 3 s (Fig. 5b, sampled as `poro-solve report --line` does), the largest
  * relative displacement of a water point from the soil point it started on (§5.3: 0.0014 m at
  * k = 1e-7 and 0.0065 m at k = 1e-3 m/s), and the mass balance of both phases.
+ *
+ * And the water pressure's pattern of period two cells (docs/numerics.md, "A pressure pattern of
+ * period two cells"): the two-cell pattern index (oscillation.h) of the water points seeded in
+ * the foundation below y = FOUNDATION_TOP, at case time PATTERN_TIME, where the issue read it
+ * (142, 212, 209, 137 ... kPa along y = 2 m). The slope's soil above is left out: where the slide
+ * has sheared the seeding lattice, neighbours on it are no longer neighbours and the index reads
+ * that as a pattern too. On the cases as they stand the pattern is there (a known failure: the
+ * consistent projection cannot see it and the pressure stabilisation that holds it down changes
+ * the failure, docs/numerics.md); with formulation.pressure_stabilisation "second_difference" it
+ * is not.
  */
 #include <math.h>
 #include <stdlib.h>
@@ -50,6 +60,12 @@ static const double snapshot_paper_time[SNAPSHOTS] = {2.0, 4.0, 6.0};   /* 000 F
 #define BAND_SAMPLES 41
 #define BAND_PAPER_TIME 3.0         /* s */
 #define BAND_PRINT_EVERY 5          /* samples between two printed on the INFO line */
+#define PATTERN_TIME 3.0            /* s, case time (the issue's t = 3 s; the paper's 2 s) */
+#define FOUNDATION_TOP 4.0          /* m: the water points seeded below it (the toe plain is at 5 m) */
+#define PATTERN_FLAG 0.1            /* pattern index that flags a pattern: about 7% of the pressure
+				       alternating along one direction (2 A / P / sqrt(2)); measured at
+				       PATTERN_TIME 0.54 (reduced) and 0.31 (paper size) on the cases, 0.034
+				       and 0.002 with the pressure stabilisation */
 
 struct slope_run {
 	int ok;
@@ -61,7 +77,30 @@ struct slope_run {
 	struct report_sample band[BAND_SAMPLES];   /* pore pressure, Pa, compression positive */
 	int band_sampled;
 	double relative_displacement;              /* m, largest over the point pairs; NAN if unpaired */
+	double pattern;                            /* pressure pattern index at PATTERN_TIME; NAN if not taken */
 };
+
+/* The two-cell pattern index of the water pressure over the water points seeded below
+ * FOUNDATION_TOP (their reference positions on the seeding lattice); NAN when undefined. */
+static double foundation_pattern(const struct case_spec *c, const struct sim *s, double h, int ppc)
+{
+	const struct particles *w = sim_water(s);
+	struct particles view = {0};
+	double *x0 = malloc(sizeof *x0 * 2 * ((size_t)w->n + 1)), *p = malloc(sizeof *p * ((size_t)w->n + 1));
+	double index = NAN;
+	struct poro_error err = {0};
+	for (idx_t q = 0; x0 && p && q < w->n; q++)
+		if (w->x0[2 * q + 1] < FOUNDATION_TOP) {
+			x0[2 * view.n] = w->x0[2 * q], x0[2 * view.n + 1] = w->x0[2 * q + 1];
+			p[view.n++] = w->pressure[q];
+		}
+	view.x0 = x0;
+	if (x0 && p && oscillation_index_pattern(&c->grid, &view, h / ppc, ppc, p, &index, &err))
+		printf("INFO pressure pattern index: %s\n", err.message), index = NAN;
+	free(x0);
+	free(p);
+	return index;
+}
 
 /* Mobilised soil: points displaced by more than one cell; the lowest initial height among them
  * marks how deep the failure reaches. */
@@ -127,9 +166,35 @@ static void set_stabilisation(json_t *doc, void *stabilisation)
 	slope_case_set(doc, "formulation", "soil_stabilisation", json_string(stabilisation));
 }
 
+static void set_pressure_stabilisation(json_t *doc, void *unused)
+{
+	slope_case_set(doc, "formulation", "pressure_stabilisation", json_string("second_difference"));
+	slope_case_set(doc, "time", "end", json_real(PATTERN_TIME));
+}
+
+/* The water pressure's pattern index at PATTERN_TIME on `file` with the pressure stabilisation. */
+static double stabilised_pattern(const char *file, double h, int ppc)
+{
+	struct case_spec *c = NULL;
+	struct sim *s = NULL;
+	if (slope_case_create(file, h, ppc, set_pressure_stabilisation, NULL, &c, &s))
+		return NAN;
+	int ok = 1;
+	while (ok && !sim_done(s))
+		ok = !sim_step(s);
+	const double index = ok ? foundation_pattern(c, s, h, ppc) : NAN;
+	if (!ok)
+		printf("INFO %s with the pressure stabilisation failed at t = %.4f s: %s\n", file, sim_time(s),
+		       sim_error(s)->message);
+	sim_destroy(&s);
+	case_destroy(&c);
+	return index;
+}
+
 static struct slope_run run_slope(const char *file, double h, int ppc, const char *stabilisation)
 {
 	struct slope_run r = {0};
+	r.pattern = NAN;
 	struct case_spec *c = NULL;
 	struct sim *s = NULL;
 	struct poro_error err = {0};
@@ -147,6 +212,8 @@ static struct slope_run run_slope(const char *file, double h, int ppc, const cha
 			offset = pair_offsets(s);
 		if (r.ok && !r.band_sampled && sim_time(s) >= INITIALISATION + BAND_PAPER_TIME - 0.5 * r.dt)
 			r.band_sampled = sample_band(s, h, &r);
+		if (r.ok && isnan(r.pattern) && sim_time(s) >= PATTERN_TIME - 0.5 * r.dt)
+			r.pattern = foundation_pattern(c, s, h, ppc);
 		if (r.ok && next < SNAPSHOTS && sim_time(s) >= INITIALISATION + snapshot_paper_time[next] - 0.5 * r.dt) {
 			if (oscillation_index(&c->grid, sim_soil(s), h / ppc, &r.oscillation[next], &err))
 				r.ok = 0, printf("INFO oscillation index: %s\n", err.message);
@@ -205,6 +272,19 @@ static void check_slope(double h, int ppc, const char *size)
 	report("k=1e-3 double point modified F-bar", h, ppc, &high);
 	report("k=1e-7 double point modified F-bar", h, ppc, &low);
 	report("k=1e-3 double point standard F-bar", h, ppc, &fbar);
+
+	/* the issue's pattern of period two cells in the water pressure (docs/numerics.md) */
+	const double stabilised = stabilised_pattern(CASE_DIR "mc_slope_k1e-3_double_point.json", h, ppc);
+	printf("INFO mc slope h=%.2f m %dx%d: pressure pattern index of the water seeded below y = %.0f m at t = %.0f s, "
+	       "k=1e-3 %.3f, k=1e-7 %.3f; k=1e-3 with the pressure stabilisation %.3f\n", h, ppc, ppc, FOUNDATION_TOP,
+	       PATTERN_TIME, high.pattern, low.pattern, stabilised);
+	snprintf(name, sizeof name, "mc_slope_%s_water_pressure_without_two_cell_pattern", size);
+	CHECK_KNOWN_FAILURE(high.pattern < PATTERN_FLAG, name, "pattern index %.3f (flagged above %.2f): the consistent "
+			    "projection cannot see the node-to-node alternation; docs/numerics.md", high.pattern,
+			    PATTERN_FLAG);
+	snprintf(name, sizeof name, "mc_slope_%s_pressure_stabilisation_removes_two_cell_pattern", size);
+	CHECK(stabilised < PATTERN_FLAG, name, "pattern index %.3f with the stabilisation against %.3f without "
+	      "(flagged above %.2f)", stabilised, high.pattern, PATTERN_FLAG);
 
 	snprintf(name, sizeof name, "mc_slope_%s_both_permeabilities_run_at_one_dt", size);
 	CHECK(high.ok && low.ok && high.dt == low.dt, name, "k=1e-3 %s, k=1e-7 %s", high.ok ? "ok" : "failed",

@@ -1,6 +1,7 @@
 /*
  * strip_load_test.c - the strip load on a saturated layer of 002 §4.2 (Table 2), run with the
- * semi-implicit double-point scheme.
+ * semi-implicit double-point scheme (tests/cases/strip_load_002.json) and with 002's own explicit
+ * stabilised single-point scheme (tests/cases/strip_load_002_explicit.json).
  *
  * 002 states a 10 m x 10 m half domain, 0.05 m cells, 2x2 points per cell, 1,600 points and a
  * 0.3 m strip. These do not fit together: 10 m x 10 m at 2x2 per cell has 1,600 points per set
@@ -14,56 +15,51 @@
  * scores O(1), a smooth field O(h^2). With the node-wise smoothing (000 Eq. 77) it must stay
  * below 1%, and switching the smoothing off must raise it at least five-fold (002 Fig. 10).
  * Soil and water mass are conserved to 1e-12.
+ *
+ * The explicit scheme (002 §4.2's own): the maximum displacement at t = 0.1 s within
+ * EXPLICIT_DISPLACEMENT_TOLERANCE (5%) of 6.737 mm; the same roughness at most 2% with its
+ * stabilisations (the cell average of the volumetric strain rates, Eqs. 26-27, and the multi-field
+ * pressure rate, Eqs. 33-34) and at least five times higher with both off (002 Fig. 10b's
+ * checkerboard); and its oscillation index of the pore pressure (oscillation.h, at the scale of
+ * the points) printed beside it.
  */
 #include "../harness.h"
 #include "case.h"
+#include "oscillation.h"
+#include "pressure_roughness.h"
 #include "poro.h"
 
 #define CASE_FILE "tests/cases/strip_load_002.json"
+#define EXPLICIT_CASE_FILE "tests/cases/strip_load_002_explicit.json"
+#define EXPLICIT_DISPLACEMENT_TOLERANCE 0.05
+#define EXPLICIT_ROUGHNESS_MAX 0.02
 #define PAPER_MAX_DISPLACEMENT 6.737e-3   /* m, 002 §4.2 at t = 0.1 s */
 #define DISPLACEMENT_TOLERANCE 0.03        /* relative */
 
 struct outcome {
-	double umax, roughness, drift;
+	double umax, roughness, oscillation, drift;
 	int ok;
 };
 
-static double roughness(const struct particles *w, double spacing)
-{
-	double sum = 0, pmax = 0;
-	long count = 0;
-	for (idx_t i = 0; i < w->n; i++)
-		pmax = fmax(pmax, fabs(w->pressure[i]));
-	for (idx_t i = 0; i < w->n; i++) {
-		double acc = 0;
-		int k = 0;
-		for (idx_t j = 0; j < w->n; j++) {
-			double dx = w->x0[2 * j] - w->x0[2 * i], dy = w->x0[2 * j + 1] - w->x0[2 * i + 1];
-			if (fabs(hypot(dx, dy) - spacing) < 1e-6 * spacing)
-				acc += w->pressure[j], k++;
-		}
-		if (k == 4) {
-			double e = w->pressure[i] - acc / 4;
-			sum += e * e;
-			count++;
-		}
-	}
-	return count && pmax > 0 ? sqrt(sum / count) / pmax : 1.0;
-}
-
-static struct outcome run(int smoothing)
+/* Runs a case file to its end, its stabilisation on or off: the semi-implicit scheme's node-wise
+ * pressure smoothing (000 Eq. 77), the explicit scheme's two (002 §3.2). */
+static struct outcome run(const char *file, int stabilised)
 {
 	struct outcome o = {0};
 	struct case_spec *c = NULL;
 	struct sim *s = NULL;
 	struct poro_error err = {0};
-	o.ok = !case_load_file(CASE_FILE, &c, &err);
+	o.ok = !case_load_file(file, &c, &err);
 	if (o.ok) {
-		c->formulation.pore_pressure_smoothing = smoothing;
+		c->formulation.pore_pressure_smoothing = stabilised;
+		if (!stabilised) {
+			c->formulation.strain_rate_smoothing = STRAIN_RATE_SMOOTHING_NONE;
+			c->formulation.pressure_rate_projection = PRESSURE_RATE_NONE;
+		}
 		o.ok = !sim_create(&s, c, &err);
 	}
 	if (!o.ok) {
-		printf("INFO cannot run %s: %s\n", CASE_FILE, err.message);
+		printf("INFO cannot run %s: %s\n", file, err.message);
 		return o;
 	}
 	double ms0 = sim_soil_mass(s), mw0 = sim_water_mass(s);
@@ -78,15 +74,37 @@ static struct outcome run(int smoothing)
 	const struct particles *p = sim_soil(s);
 	for (idx_t q = 0; q < p->n; q++)
 		o.umax = fmax(o.umax, hypot(p->x[2 * q] - p->x0[2 * q], p->x[2 * q + 1] - p->x0[2 * q + 1]));
-	o.roughness = roughness(sim_water(s), c->grid.cell_size / c->bodies[0].particles_per_cell);
+	const double spacing = c->grid.cell_size / c->bodies[0].particles_per_cell;
+	o.roughness = pressure_roughness(sim_water(s), spacing);
+	if (oscillation_index_of(&c->grid, sim_soil(s), spacing, 1, sim_is_double_point(s) ? NULL : sim_water(s)->pressure,
+				 &o.oscillation, &err))
+		o.oscillation = NAN;   /* double point: the pressure lives on the water points */
 	sim_destroy(&s);
 	case_destroy(&c);
 	return o;
 }
 
+static void check_explicit(void)
+{
+	struct outcome smooth = run(EXPLICIT_CASE_FILE, 1), rough = run(EXPLICIT_CASE_FILE, 0);
+	printf("INFO strip load, explicit scheme, t=0.1 s: maximum displacement %.3f mm (002: %.3f mm; %.3f mm "
+	       "without stabilisation); pore-pressure roughness %.4f with the stabilisations, %.4f without; "
+	       "oscillation index of p %.4f and %.4f\n", 1e3 * smooth.umax, 1e3 * PAPER_MAX_DISPLACEMENT,
+	       1e3 * rough.umax, smooth.roughness, rough.roughness, smooth.oscillation, rough.oscillation);
+	CHECK(smooth.ok && rough.ok, "strip_load_explicit_runs", "a run failed");
+	const double rel = fabs(smooth.umax - PAPER_MAX_DISPLACEMENT) / PAPER_MAX_DISPLACEMENT;
+	CHECK(smooth.ok && rel <= EXPLICIT_DISPLACEMENT_TOLERANCE, "strip_load_explicit_max_displacement_matches_002",
+	      "%.3f mm against 002's %.3f mm (%.1f%%)", 1e3 * smooth.umax, 1e3 * PAPER_MAX_DISPLACEMENT, 100 * rel);
+	CHECK(smooth.ok && smooth.roughness <= EXPLICIT_ROUGHNESS_MAX, "strip_load_explicit_pore_pressure_smooth",
+	      "roughness %.4f", smooth.roughness);
+	CHECK(rough.roughness >= 5 * smooth.roughness, "strip_load_explicit_stabilisation_removes_checkerboard",
+	      "roughness %.4f without vs %.4f with", rough.roughness, smooth.roughness);
+}
+
 int main(void)
 {
-	struct outcome smooth = run(1), rough = run(0);
+	check_explicit();
+	struct outcome smooth = run(CASE_FILE, 1), rough = run(CASE_FILE, 0);
 	printf("INFO strip load t=0.1 s: maximum displacement %.3f mm (002: %.3f mm); pore-pressure "
 	       "roughness %.4f with smoothing, %.4f without\n", 1e3 * smooth.umax, 1e3 * PAPER_MAX_DISPLACEMENT,
 	       smooth.roughness, rough.roughness);

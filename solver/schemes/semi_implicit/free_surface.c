@@ -16,7 +16,10 @@
  * nodes inside the Xie-Leo column where its water points gather. Counting merely occupied cells is
  * not enough: a single expelled water point in the cell above the soil would move the free
  * surface a whole cell up. Beyond a grid face where the water is unconstrained lies open air, so
- * the cells there count as dry; beyond a wall, they do not count.
+ * the cells there count as dry; beyond a wall, they do not count. The soil of a dry body
+ * ("saturated": false) holds no water and never counts: its cells are full only where water that
+ * seeped into it fills them, so the nodes next to it are held at p = 0 like those of a free
+ * surface, and a saturated body drains into it (docs/numerics.md, "Dry bodies").
  *
  * How p = 0 is held there.
  *  - "nodes" (default, the paper's step 5b): every node next to a cell that is not full gets
@@ -123,7 +126,8 @@ static void mark_full_cells(struct sim *s)
 	if (!s->double_point)
 		return;
 	/* saturated soil fills a cell below the top of its column's water (file comment) */
-	cell_volumes(g, &s->soil, si->cell_fill_soil);
+	const struct particles wet = semi_implicit_wet_soil(s);
+	cell_volumes(g, &wet, si->cell_fill_soil);
 	#pragma omp parallel for schedule(static)
 	for (idx_t ci = 0; ci < g->cells[0]; ci++) {
 		int below_water = 0;

@@ -16,8 +16,13 @@
  *    velocities then satisfy the weak continuity equation -G^T v = 0 exactly, and the pressure
  *    forces of the predictors use the same G on the nodal pressure, so a pressure error is removed
  *    in one step instead of being fed back (docs/numerics.md has the measurements).
- *    Equal-order B-splines leave a node-to-node pressure pattern nearly outside A's reach; the
- *    case may hold it down with formulation.pressure_stabilisation (pressure_stabilisation.c).
+ *    Equal-order B-splines leave a node-to-node pressure pattern nearly outside A's reach (on a
+ *    regular seeding exactly: G of the alternation vanishes wherever the points are symmetric
+ *    about the nodes, pressure_test), and the solve gives it whatever the near-null ratio of the
+ *    right-hand side to its eigenvalue is, every step afresh: the failing Mohr-Coulomb slopes
+ *    show it as stripes of period two cells (docs/numerics.md, "A pressure pattern of period two
+ *    cells"). The case may hold it down with formulation.pressure_stabilisation
+ *    (pressure_stabilisation.c).
  *
  * Boundary conditions: impermeable faces need nothing (the natural condition of Eq. 32). Where
  * the pressure is zero, on the free water surface and on drained faces, free_surface.c decides,
@@ -191,7 +196,8 @@ void pressure_gradient_operators(struct sim *s)
 	const size_t gst = (size_t)ps->g_width * ps->g_width * 2, nodes = (size_t)s->grid.node_count;
 	grid_zero(ps->grad_s, nodes * gst);
 	grid_zero(ps->grad_w, nodes * gst);
-	add_gradient_operator(s, &s->soil, ps->grad_s);
+	const struct particles wet = semi_implicit_wet_soil(s);   /* dry bodies feel no pore pressure */
+	add_gradient_operator(s, &wet, ps->grad_s);
 	add_gradient_operator(s, &s->water, ps->grad_w);
 	if (s->spec->formulation.free_surface == FREE_SURFACE_WEAK) {   /* free_surface.c */
 		free_surface_add_boundary_term(s, s->f.mass_s, ps->grad_s);
@@ -356,9 +362,10 @@ void pressure_divergence_rhs(struct sim *s, const double *v_s, const double *v_w
 	struct grid_fields *f = &s->f;
 	const struct grid *g = &s->grid;
 	double *sum_s = si->correction_s, *sum_w = si->correction_w;   /* free until step 6 */
+	const struct particles wet = semi_implicit_wet_soil(s);   /* a dry body's volume change needs no water */
 	memset(sum_s, 0, sizeof(double) * (size_t)g->node_count);
 	memset(sum_w, 0, sizeof(double) * (size_t)g->node_count);
-	p2g_point_divergence(g, &s->soil, s->soil.volume, v_s, sum_s);
+	p2g_point_divergence(g, &wet, wet.volume, v_s, sum_s);
 	p2g_point_divergence(g, &s->water, s->water.volume, v_w, sum_w);
 	#pragma omp parallel for schedule(static)
 	for (idx_t I = 0; I < g->node_count; I++)
@@ -440,7 +447,7 @@ enum poro_status pressure_solve(struct sim *s)
 {
 	struct semi_implicit *si = semi_implicit_of(s);
 	struct pressure_system *ps = &si->ps;
-	const struct particles *p = &s->soil, *w = &s->water;
+	const struct particles wet = semi_implicit_wet_soil(s), *p = &wet, *w = &s->water;
 	double t0 = sim_clock();
 	grid_zero(ps->stencil, (size_t)s->grid.node_count * ps->width * ps->width);
 	double diagonal_mean = 0.0;

@@ -216,8 +216,9 @@ static void correct_velocities(struct sim *s)
 		memset(si->correction_w, 0, 2 * sizeof(double) * (size_t)g->node_count);
 		pressure_apply_gradient(s, si->ps.grad_s, si->dp, si->correction_s);
 		pressure_apply_gradient(s, si->ps.grad_w, si->dp, si->correction_w);
-	} else {
-		p2g_point_gradient(g, &s->soil, s->soil.volume, si->dp, si->correction_s);
+	} else {   /* the pressure pushes the saturated skeleton only (semi_implicit_wet_soil) */
+		const struct particles wet = semi_implicit_wet_soil(s);
+		p2g_point_gradient(g, &wet, wet.volume, si->dp, si->correction_s);
 		p2g_point_gradient(g, &s->water, s->water.volume, si->dp, si->correction_w);
 	}
 	#pragma omp parallel for schedule(static)
@@ -293,14 +294,6 @@ static enum poro_status update_soil_kinematics(struct sim *s)
 	return deformation_apply(s);
 }
 
-/* Runs one phase and adds its wall time to the phase's account. */
-#define PHASE(which, call)                                              \
-	do {                                                            \
-		double t0_ = sim_clock();                               \
-		call;                                                   \
-		s->phase_seconds[which] += sim_clock() - t0_;           \
-	} while (0)
-
 enum poro_status semi_implicit_step(struct sim *s)
 {
 	enum poro_status st = PORO_OK;
@@ -335,6 +328,8 @@ enum poro_status semi_implicit_step(struct sim *s)
 
 const struct scheme semi_implicit_scheme = {
 	.name = "semi_implicit",
+	.phase_names = { "shape functions", "particle-to-grid", "predictors", "pressure assembly",
+			 "pressure factor+solve", "correction", "grid-to-particle", "kinematics", "stress update" },
 	.create = create,
 	.destroy = destroy,
 	.step = semi_implicit_step,

@@ -74,8 +74,19 @@ static inline struct semi_implicit *semi_implicit_of(const struct sim *s)
 	return (struct semi_implicit *)s->scheme_state;
 }
 
+/* The soil points of the saturated bodies, the first s->saturated_soil of the soil set: the skeleton
+ * whose pores hold the water of Eqs. 32 and 60-68. A dry body's points ("saturated": false) carry
+ * no pore pressure and do not take part in the mixture's continuity (their pores hold air), so the
+ * pressure matrix, its right-hand side and the pressure's push on the soil are sums over these
+ * alone (docs/numerics.md, "Dry bodies"). The whole soil set when every body is saturated. */
+static inline struct particles semi_implicit_wet_soil(const struct sim *s)
+{
+	struct particles wet = s->soil;
+	wet.n = s->saturated_soil;
+	return wet;
+}
+
 /* semi_implicit.c: the scheme's entry in scheme.h, and its step (000 §4.5). */
-extern const struct scheme semi_implicit_scheme;
 enum poro_status semi_implicit_step(struct sim *s);
 
 /* pressure.c: the Poisson solve (000 §4.5 step 5). */
