@@ -23,6 +23,11 @@
  * point with AFLIP (the water set riding on the soil set's blocks), storage of cavitating water
  * points (the cavitation column pulled faster), and water points leaving through a drained face,
  * after which the blocks of the shrunk set are sorted again (a permeable drained column).
+ * Paper 002's explicit scheme (the strip load on 0.25 m cells: its masses, forces, cell averages
+ * and pressure-rate moments scattered in block order; and a column with the linear basis) and
+ * paper 001's implicit scheme (the footing turning plastic under the consistent tangent: the
+ * kinematics' scatter, the residual with its stress updates and the matrix assembled in block
+ * order) are compared the same way.
  */
 #include <omp.h>
 #include <string.h>
@@ -132,6 +137,46 @@ static void permeable(json_t *doc, void *user)
 	slope_case_set(doc, "gravity", "acceleration", g);
 }
 
+/* 002's explicit scheme with the linear basis of the pressure-rate projection (its moment
+ * scatter; the default constant basis runs in the strip load variant). */
+static void with_linear_basis(json_t *doc, void *user)
+{
+	(void)user;
+	slope_case_set(doc, "formulation", "pressure_rate_basis", json_string("linear"));
+}
+
+/* 001's footing with the consistent tangent (the assembly every Newton iteration), its load rising
+ * to 5 c in 1 s: the Tresca soil under the footing turns plastic within the run's 20 steps. */
+static void footing_fast(json_t *doc, void *user)
+{
+	(void)user;
+	slope_case_set(doc, "formulation", "tangent", json_string("consistent"));
+	json_t *load = json_array_get(json_object_get(doc, "loads"), 0);
+	json_object_set_new(json_object_get(load, "time_function"), "ramp_time", json_real(2.0));
+}
+
+static int explicit_taken(const struct sim *s, char *what, size_t size)
+{
+	const struct case_formulation *f = &s->spec->formulation;
+	snprintf(what, size, "scheme %d, strain-rate smoothing %d, pressure-rate projection %d, basis %d", (int)f->scheme,
+		 (int)f->strain_rate_smoothing, (int)f->pressure_rate_projection, (int)f->pressure_rate_basis);
+	return f->scheme == SCHEME_EXPLICIT && f->strain_rate_smoothing == STRAIN_RATE_SMOOTHING_CELL_AVERAGE &&
+	       f->pressure_rate_projection == PRESSURE_RATE_MULTI_FIELD;
+}
+
+static int implicit_taken(const struct sim *s, char *what, size_t size)
+{
+	int last = 0, count = 0;
+	long total = 0;
+	sim_iterations(s, &last, &total, NULL, &count);
+	idx_t plastic = 0;
+	for (idx_t q = 0; q < s->soil.n; q++)
+		plastic += s->soil.plastic_strain[q] > 0.0;
+	snprintf(what, size, "scheme %d, %ld Newton iterations, %ld plastic points", (int)s->spec->formulation.scheme,
+		 total, (long)plastic);
+	return s->spec->formulation.scheme == SCHEME_IMPLICIT_UPU && total > 0 && plastic > 0;
+}
+
 static int laplacian_taken(const struct sim *s, char *what, size_t size)
 {
 	snprintf(what, size, "projection %d, velocity update %d, load through the points %d",
@@ -234,6 +279,11 @@ int main(void)
 		 single_point_taken},
 		{"cavitation", "tests/cases/cavitation_column.json", 0.025, 2, 400, pulled_fast, cavitation_taken},
 		{"water_outflow", "tests/cases/terzaghi_double_drained.json", 0.025, 2, 600, permeable, outflow_taken},
+		{"explicit_strip_load", "tests/cases/strip_load_002_explicit.json", 0.25, 2, 300, NULL, explicit_taken},
+		{"explicit_linear_basis", "tests/cases/terzaghi_002.json", 0.025, 2, 300, with_linear_basis,
+		 explicit_taken},
+		{"implicit_footing_consistent", "tests/cases/strip_footing_001.json", 0.25, 2, 20, footing_fast,
+		 implicit_taken},
 	};
 	for (size_t k = 0; k < sizeof variants / sizeof variants[0]; k++)
 		check_variant(&variants[k]);

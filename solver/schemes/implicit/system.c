@@ -32,6 +32,7 @@
 
 #include "implicit.h"
 #include "material.h"
+#include "point_blocks.h"
 #include "shape.h"
 
 #define NEIGHBOURS 25   /* nodes within two cells, 5 x 5 */
@@ -216,8 +217,10 @@ void implicit_system_assemble(struct sim *s)
 	const double dt = s->dt, cM = 1.0 / (form->newmark_beta * dt * dt);
 	const double cC = form->newmark_gamma / (form->newmark_beta * dt), alpha = e->pressure_scale;
 	const int lumped = form->mass_matrix == MASS_MATRIX_LUMPED;
-	memset(e->values, 0, sizeof(double) * (size_t)e->colptr[e->unknowns]);
-	for (idx_t q = 0; q < p->n; q++) {
+	grid_zero(e->values, (size_t)e->colptr[e->unknowns]);
+	/* a point adds into the columns of its support nodes only, rows of its support nodes: the
+	 * scatter order of point_blocks.h runs it in parallel with sums independent of the threads */
+	FOR_POINTS_BY_BLOCK(p, q, {
 		struct point_operators o;
 		point_operators(s, q, &o);
 		const struct point_physics ph = point_physics(s, q);
@@ -250,7 +253,7 @@ void implicit_system_assemble(struct sim *s)
 				add_block(e, o.node[ka], o.node[kb], nx, block);
 			}
 		}
-	}
+	});
 	/* unknowns that are not free: their rows and columns zero, a unit diagonal */
 #pragma omp parallel for schedule(static)
 	for (idx_t j = 0; j < e->unknowns; j++)
@@ -268,6 +271,16 @@ struct point_increments {
 	double a_u[2], a_w[2], v_u[2], v_w[2];   /* the iterate's a_{n+1}, v_{n+1} at the point */
 };
 
+/* Keeps err as the step's error if point q is the lowest failing point so far (*failed). */
+static void keep_lowest_failure(struct sim *s, idx_t q, const struct poro_error *err, idx_t *failed)
+{
+#pragma omp critical(implicit_residual_failure)
+	if (q < *failed) {
+		*failed = q;
+		s->err = *err;
+	}
+}
+
 enum poro_status implicit_system_residual(struct sim *s)
 {
 	struct implicit_state *e = implicit_of(s);
@@ -282,13 +295,16 @@ enum poro_status implicit_system_residual(struct sim *s)
 	/* a_{n+1} and v_{n+1} of the iterate at the nodes (Newmark, 001 Eq. 8); the residual starts
 	 * as f_{n+1} */
 	double *a_new = e->acceleration_new, *v_new = e->velocity_new;
+#pragma omp parallel for schedule(static)
 	for (idx_t k = 0; k < N; k++) {
 		a_new[k] = cM * e->increment[k] - cV * e->velocity[k] - cA * e->acceleration[k];
 		v_new[k] = cC * e->increment[k] - cVv * e->velocity[k] - cVa * e->acceleration[k];
 		e->residual[k] = e->external[k];
 	}
-	enum poro_status status = PORO_OK;
-	for (idx_t q = 0; q < p->n && !status; q++) {
+	idx_t failed = p->n;
+	/* q's stress and state, rows of q's support nodes: in parallel in the scatter order of
+	 * point_blocks.h; every point is updated and the failure kept is the lowest point's */
+	FOR_POINTS_BY_BLOCK(p, q, {
 		struct point_operators o;
 		point_operators(s, q, &o);
 		const struct point_physics ph = point_physics(s, q);
@@ -322,7 +338,9 @@ enum poro_status implicit_system_residual(struct sim *s)
 			.elastic_only = elastic_only,
 		};
 		const struct material *m = &s->materials[s->spec->bodies[p->body[q]].material];
-		status = material_update(m, &u, &s->err);
+		struct poro_error err;
+		if (material_update(m, &u, &err) != PORO_OK)
+			keep_lowest_failure(s, q, &err, &failed);
 		const double pressure = -w->pressure[q] + in.dp, p0 = -w->pressure0[q];   /* compression + */
 		const double eps_u = p->volumetric_strain[q] + in.vol_u, eps_w = w->volumetric_strain[q] + in.vol_w;
 		const double *sg = p->stress + 4 * q, pn = (1.0 - ph.n) * pressure;
@@ -343,11 +361,12 @@ enum poro_status implicit_system_residual(struct sim *s)
 			}
 			r[DOF_P] += ph.V * o.w[k] * balance;   /* -f_p */
 		}
-	}
+	});
+#pragma omp parallel for schedule(static)
 	for (idx_t k = 0; k < N; k++)
 		if (e->kind[k] != DOF_FREE)
 			e->residual[k] = 0.0;
-	return status;
+	return failed < p->n ? s->err.code : PORO_OK;
 }
 
 void implicit_point_volumetric(const struct sim *s, idx_t q, double *eps_u, double *eps_w)
