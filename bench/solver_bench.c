@@ -1,5 +1,5 @@
 /*
- * solver_bench.c - speed of the semi-implicit scheme: microseconds per material-point step.
+ * solver_bench.c - speed of a scheme's step: microseconds per material-point step.
  *
  * A 2-D double-point (or single-point) linear elastic block on a roller box, loaded by a strip
  * traction and its own weight, with at least 100,000 soil points by default (2x2 points per
@@ -20,8 +20,13 @@
  * functions phase, is timed apart on one thread: BINNING_REPEATS sorts of each set, per
  * material-point step.
  *
+ * --scheme runs the same block by paper 002's explicit scheme or paper 001's implicit u-p-U
+ * scheme instead (scheme_keys: each as its cases run it, at its own step), so that the schemes'
+ * costs per material-point step and their speed-ups on two threads stand side by side.
+ *
  *   solver_bench [--cells-x N] [--cells-y N] [--ppc N] [--steps N] [--single-point]
  *                [--projection laplacian|consistent] [--threads N[,N...]]   (default 1,2)
+ *                [--scheme semi_implicit|explicit|implicit_upU]
  */
 #include <omp.h>
 #include <stdio.h>
@@ -37,24 +42,50 @@
 #define COUNTS_MAX 4   /* thread counts compared in one run */
 #define BINNING_REPEATS 20
 
-static char *make_case(int cells_x, int cells_y, int ppc, const char *phases, const char *projection)
+/* The formulation and time keys of each scheme: the semi-implicit scheme with the given phases
+ * and projection at dt 1e-4 s; paper 002's explicit scheme as its cases run it (single point,
+ * uGIMP, a compressible fluid) at 0.9 of its critical step ("auto"); paper 001's implicit scheme
+ * (uGIMP, B-bar, the elastic tangent) at 1e-3 s, about 40 explicit critical steps of this block,
+ * where its Terzaghi column stays within 2% of q (consolidation_001_test). */
+static void scheme_keys(const char *scheme, const char *phases, const char *projection, char *formulation,
+			size_t size, const char **dt)
+{
+	if (!strcmp(scheme, "explicit")) {
+		snprintf(formulation, size, "\"scheme\": \"explicit\", \"phases\": \"single_point\", \"shape\": \"gimp\"");
+		*dt = "\"auto\"";
+	} else if (!strcmp(scheme, "implicit_upU")) {
+		snprintf(formulation, size, "\"scheme\": \"implicit_upU\", \"shape\": \"gimp\"");
+		*dt = "1e-3";
+	} else {
+		snprintf(formulation, size, "\"scheme\": \"%s\", \"phases\": \"%s\", \"pressure_projection\": \"%s\"",
+			 scheme, phases, projection);
+		*dt = "1e-4";
+	}
+}
+
+static char *make_case(int cells_x, int cells_y, int ppc, const char *scheme, const char *phases,
+		       const char *projection)
 {
 	const double h = 0.1, width = cells_x * h, height = cells_y * h;
+	char formulation[256];
+	const char *dt;
+	scheme_keys(scheme, phases, projection, formulation, sizeof formulation, &dt);
 	char *json = malloc(4096);
 	snprintf(json, 4096,
 		 "{\"schema\": \"poro-case/1\", \"title\": \"benchmark block\","
-		 " \"formulation\": {\"scheme\": \"semi_implicit\", \"phases\": \"%s\", \"pressure_projection\": \"%s\"},"
+		 " \"formulation\": {%s},"
 		 " \"grid\": {\"origin\": [0, 0], \"extent\": [%g, %g], \"cell_size\": %g},"
 		 " \"materials\": [{\"name\": \"soil\", \"model\": \"linear_elastic\", \"density\": 2650,"
 		 "   \"youngs_modulus\": 1e7, \"poisson_ratio\": 0.3}],"
 		 " \"bodies\": [{\"name\": \"block\", \"material\": \"soil\", \"rectangle\": {\"min\": [0, 0], \"max\": [%g, %g]},"
 		 "   \"particles_per_cell\": %d, \"porosity\": 0.3, \"hydraulic_conductivity\": 1e-4}],"
+		 " \"fluid\": {\"density\": 1000, \"bulk_modulus\": 2.2e9},"
 		 " \"gravity\": {\"acceleration\": [0, -9.81]},"
 		 " \"boundaries\": {\"left\": {\"soil\": \"slip\", \"water\": \"slip\"}, \"right\": {\"soil\": \"slip\", \"water\": \"slip\"},"
 		 "   \"bottom\": {\"soil\": \"fixed\", \"water\": \"slip\"}},"
 		 " \"loads\": [{\"body\": \"block\", \"face\": \"top\", \"from\": 0, \"to\": %g, \"traction\": [0, -2e4]}],"
-		 " \"time\": {\"dt\": 1e-4, \"end\": 1}}",
-		 phases, projection, width, height + 1.0, h, width, height, ppc, width / 5);
+		 " \"time\": {\"dt\": %s, \"end\": 1}}",
+		 formulation, width, height + 1.0, h, width, height, ppc, width / 5, dt);
 	return json;
 }
 
@@ -109,13 +140,14 @@ int main(int argc, char **argv)
 {
 	int cells_x = 250, cells_y = 100, ppc = 2, steps = 20;
 	int counts[COUNTS_MAX] = {1, 2}, runs = 2;
-	const char *phases = "double_point", *projection = "laplacian";
+	const char *phases = "double_point", *projection = "laplacian", *scheme = "semi_implicit";
 	for (int i = 1; i < argc; i++) {
 		if (!strcmp(argv[i], "--cells-x") && i + 1 < argc) cells_x = atoi(argv[++i]);
 		else if (!strcmp(argv[i], "--cells-y") && i + 1 < argc) cells_y = atoi(argv[++i]);
 		else if (!strcmp(argv[i], "--ppc") && i + 1 < argc) ppc = atoi(argv[++i]);
 		else if (!strcmp(argv[i], "--steps") && i + 1 < argc) steps = atoi(argv[++i]);
 		else if (!strcmp(argv[i], "--single-point")) phases = "single_point";
+		else if (!strcmp(argv[i], "--scheme") && i + 1 < argc) scheme = argv[++i];
 		else if (!strcmp(argv[i], "--projection") && i + 1 < argc) projection = argv[++i];
 		else if (!strcmp(argv[i], "--threads") && i + 1 < argc && (runs = parse_threads(argv[++i], counts))) ;
 		else {
@@ -123,7 +155,7 @@ int main(int argc, char **argv)
 			return 2;
 		}
 	}
-	char *json = make_case(cells_x, cells_y, ppc, phases, projection);
+	char *json = make_case(cells_x, cells_y, ppc, scheme, phases, projection);
 	struct case_spec *c = NULL;
 	struct sim *s[COUNTS_MAX] = {NULL};
 	struct poro_error err = {0};
@@ -150,9 +182,14 @@ int main(int argc, char **argv)
 			}
 		}
 	const char *policy = getenv("OMP_WAIT_POLICY");
-	printf("%s, %s projection: %ld soil + %ld water points, %d x %d cells, %d steps timed, the thread counts "
-	       "stepped in turn (OMP_WAIT_POLICY=%s)\n", phases, projection, (long)sim_soil(s[0])->n,
-	       sim_is_double_point(s[0]) ? (long)sim_water(s[0])->n : 0L, cells_x, cells_y, steps,
+	char what[96];
+	if (!strcmp(scheme, "semi_implicit"))
+		snprintf(what, sizeof what, "%s, %s, %s projection", scheme, phases, projection);
+	else
+		snprintf(what, sizeof what, "%s, single point, uGIMP", scheme);
+	printf("%s: %ld soil + %ld water points, %d x %d cells, dt %.3g s, %d steps timed, the thread counts "
+	       "stepped in turn (OMP_WAIT_POLICY=%s)\n", what, (long)sim_soil(s[0])->n,
+	       sim_is_double_point(s[0]) ? (long)sim_water(s[0])->n : 0L, cells_x, cells_y, c->time.dt, steps,
 	       policy ? policy : "unset");
 	printf("  us per material-point step");
 	for (int r = 0; r < runs; r++)
@@ -168,9 +205,16 @@ int main(int argc, char **argv)
 			us[r][PHASE_COUNT] += v;
 			us[r][ph == PHASE_PRESSURE_ASSEMBLY || ph == PHASE_PRESSURE_SOLVE ? PHASE_COUNT + 2 : PHASE_COUNT + 1] += v;
 		}
+	/* the semi-implicit pressure system's two phases (the implicit scheme's matrix and factors, the
+	 * explicit scheme's pressure rate) against the rest of the step */
+	const char *assembly = sim_phase_name_of(s[0], PHASE_PRESSURE_ASSEMBLY), *solve = sim_phase_name_of(s[0], PHASE_PRESSURE_SOLVE);
+	char pair[80];
+	snprintf(pair, sizeof pair, "%s%s%s", assembly ? assembly : "", solve ? " + " : "", solve ? solve : "");
 	for (int row = 0; row < PHASE_COUNT + 3; row++) {
-		const char *name = row < PHASE_COUNT ? sim_phase_name(row) : row == PHASE_COUNT ? "TOTAL" :
-				   row == PHASE_COUNT + 1 ? "particle and grid phases" : "pressure assembly+solve";
+		const char *name = row < PHASE_COUNT ? sim_phase_name_of(s[0], row) : row == PHASE_COUNT ? "TOTAL" :
+				   row == PHASE_COUNT + 1 ? "the other phases" : pair;
+		if (!name)   /* a phase this scheme does not have */
+			continue;
 		printf("  %-26s", name);
 		for (int r = 0; r < runs; r++)
 			printf("  %9.4f", us[r][row]);
