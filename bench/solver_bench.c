@@ -32,6 +32,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
 
 #include "case.h"
 #include "point_blocks.h"
@@ -119,6 +120,16 @@ static double binning_us(struct sim *s, long points)
 	return us;
 }
 
+/* The process's CPU time, s, all threads: on a loaded machine the wall time of a step counts the
+ * time its threads wait for a core; this counts what they did (with OMP_WAIT_POLICY=passive, no
+ * spinning at the barriers). */
+static double cpu_seconds(void)
+{
+	struct timespec t;
+	clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
+	return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
+}
+
 /* Parses "1,2" into counts; returns how many, 0 if malformed. */
 static int parse_threads(const char *list, int *counts)
 {
@@ -169,17 +180,20 @@ int main(int argc, char **argv)
 			return 2;
 		}
 	long points = (long)sim_soil(s[0])->n + (sim_is_double_point(s[0]) ? (long)sim_water(s[0])->n : 0);
-	double before[COUNTS_MAX][PHASE_COUNT];
+	double before[COUNTS_MAX][PHASE_COUNT], cpu[COUNTS_MAX] = {0};
 	for (int k = 0; k < WARMUP + steps; k++)
 		for (int r = 0; r < runs; r++) {
 			if (k == WARMUP)
 				for (int ph = 0; ph < PHASE_COUNT; ph++)
 					before[r][ph] = sim_phase_seconds(s[r], ph);
 			omp_set_num_threads(counts[r]);
+			const double c0 = cpu_seconds();
 			if (sim_step(s[r])) {
 				fprintf(stderr, "solver_bench: %s\n", sim_error(s[r])->message);
 				return 3;
 			}
+			if (k >= WARMUP)
+				cpu[r] += cpu_seconds() - c0;
 		}
 	const char *policy = getenv("OMP_WAIT_POLICY");
 	char what[96];
@@ -222,6 +236,12 @@ int main(int argc, char **argv)
 			printf("  %10.2f", us[r][row] > 0.0 ? us[0][row] / us[r][row] : 0.0);
 		printf("\n");
 	}
+	printf("  CPU time, all threads     ");
+	for (int r = 0; r < runs; r++)
+		printf("  %9.4f", 1e6 * cpu[r] / ((double)steps * points));
+	for (int r = 1; r < runs; r++)
+		printf("  %10.2f", cpu[r] > 0.0 ? cpu[0] / cpu[r] : 0.0);
+	printf("   (the process's CPU time: what the threads did, waiting for the machine left out)\n");
 	printf("  binning into blocks (in the shape functions, one thread): %.4f us per material-point step\n",
 	       binning_us(s[0], points));
 	for (int r = 1; r < runs; r++)
