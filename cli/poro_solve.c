@@ -71,6 +71,8 @@ static void on_signal(int sig)
 }
 
 #define PROGRAM "poro-solve"
+/* The iterations of the last step whose energy the progress line prints, at most. */
+#define PROGRESS_ENERGIES 8
 
 static int parse_run(const struct subcommand *self, int argc, char **argv);
 static int parse_validate(const struct subcommand *self, int argc, char **argv);
@@ -148,6 +150,15 @@ static void print_progress(const struct sim_progress *p, void *user)
 	       p->steps_total, p->time, p->wall_seconds, p->us_per_point_step);
 	if (p->iterations_mean > 0.0)   /* after the figures the worker reads (worker/log_pump.c) */
 		printf("  Newton iterations %d (mean %.2f)", p->iterations_last, p->iterations_mean);
+	/* the last step's convergence, each iteration's energy against the first's: linear (modified
+	 * Newton) or quadratic (the consistent tangent) at a glance */
+	if (p->energies && p->energy_count > 1 && p->energies[0] > 0.0) {
+		printf("  |delta . r| / first:");
+		for (int k = 1; k < p->energy_count && k <= PROGRESS_ENERGIES; k++)
+			printf(" %.1e", p->energies[k] / p->energies[0]);
+		if (p->energy_count > PROGRESS_ENERGIES + 1)
+			printf(" ...");
+	}
 	printf("\n");
 	fflush(stdout);
 }

@@ -96,6 +96,9 @@ struct sim_progress {
 					    DIR/checkpoint.h5 now holds this step (checkpoint.h) */
 	int iterations_last;             /* a scheme that iterates (sim_iterations): the last step's */
 	double iterations_mean;          /* and the mean a step since the start; 0 for the others */
+	const double *energies;          /* the last step's |delta . r| per iteration (its first
+					    energy_count, at most SIM_ITERATIONS_KEPT); NULL for the others */
+	int energy_count;
 };
 typedef void (*sim_progress_fn)(const struct sim_progress *p, void *user);
 

@@ -73,8 +73,10 @@ static void report(struct sim *s, sim_progress_fn progress, void *user, double t
 	};
 	long total;
 	int count;
-	if (sim_iterations(s, &pr.iterations_last, &total, NULL, &count))
+	if (sim_iterations(s, &pr.iterations_last, &total, &pr.energies, &count)) {
 		pr.iterations_mean = steps > 0 ? (double)total / (double)s->step : 0.0;
+		pr.energy_count = count;
+	}
 	progress(&pr, user);
 }
 

@@ -258,19 +258,6 @@ void case_check_scheme(struct case_reader *r, const struct case_spec *c)
 		return;
 	}
 	const char *scheme = scheme_names[c->formulation.scheme];
-	/* the small-strain tangent d sigma / d eps is the Jacobian of the scheme's residual (spec-001
-	 * §3.4: linearised strain at x_n); a finite-strain model's d tau / d ln Be_trial is not */
-	if (c->formulation.scheme == SCHEME_IMPLICIT_UPU && c->formulation.tangent == NEWTON_TANGENT_CONSISTENT)
-		for (int m = 0; m < c->material_count; m++) {
-			const struct case_material *mat = &c->materials[m];
-			if (mat->model == MODEL_LINEAR_ELASTIC || (mat->model != MODEL_HENCKY && mat->strain == STRAIN_SMALL))
-				continue;
-			char pointer[CASE_POINTER_MAX];
-			case_pointer_index(pointer, "/materials", (size_t)m);
-			case_problem(r, pointer, "material '%s' is finite strain: /formulation/tangent \"consistent\" takes "
-				     "small-strain materials (\"linear_elastic\", or \"strain\": \"small\"), whose tangent is the "
-				     "Jacobian of the implicit_upU scheme's linearised strain", mat->name);
-		}
 	static const char *const face_names[] = { "left", "right", "bottom", "top" };
 	if (c->fluid.cavitation_pressure < 0)
 		case_problem(r, "/fluid/cavitation_pressure", "applies to the \"semi_implicit\" scheme only (the "

@@ -16,8 +16,8 @@
 	X(state, STATE_MAX, skel) X(plastic_strain, 1, skel)       \
 	X(dF, 4, skel) X(surface, 2, skel)                         \
 	X(shape, 4 * SHAPE_SUPPORT_MAX, !alias)                    \
-	X(C, 4, 0) X(dF_zz, 1, 0) X(acceleration, 2, 0) X(volumetric_strain, 1, 0)  \
-	X(pressure0, 1, 0) /* allocated on request: particles_add_affine, _out_of_plane, _implicit_state */
+	X(C, 4, 0) X(dF_zz, 1, 0) X(acceleration, 2, 0) \
+	/* allocated on request: particles_add_affine, _out_of_plane, _implicit_state */
 
 static enum poro_status allocate(struct particles *p, idx_t n, int skel, int alias, struct poro_error *err)
 {
@@ -94,9 +94,7 @@ enum poro_status particles_add_out_of_plane(struct particles *p, struct poro_err
 enum poro_status particles_add_implicit_state(struct particles *p, struct poro_error *err)
 {
 	const size_t n = p->n > 0 ? (size_t)p->n : 1;
-	if ((!p->acceleration && !(p->acceleration = calloc(2 * n, sizeof(double)))) ||
-	    (!p->volumetric_strain && !(p->volumetric_strain = calloc(n, sizeof(double)))) ||
-	    (!p->pressure0 && !(p->pressure0 = calloc(n, sizeof(double)))))
+	if (!p->acceleration && !(p->acceleration = calloc(2 * n, sizeof(double))))
 		return poro_error_set(err, PORO_ENOMEM, "cannot allocate the implicit state of %ld points", (long)p->n);
 	return PORO_OK;
 }
@@ -128,7 +126,7 @@ void particles_release(struct particles *p)
 	}
 	free(p->v); free(p->C); free(p->mass); free(p->pressure);
 	free(p->stress); free(p->F); free(p->Be); free(p->state); free(p->plastic_strain);
-	free(p->dF); free(p->dF_zz); free(p->acceleration); free(p->volumetric_strain); free(p->pressure0);
+	free(p->dF); free(p->dF_zz); free(p->acceleration);
 	free(p->surface); free(p->surface_load);
 	point_blocks_destroy(&p->blocks);
 	memset(p, 0, sizeof *p);

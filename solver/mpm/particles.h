@@ -60,10 +60,6 @@ struct particles {
 	/* the implicit u-p-U scheme's state between steps (001 Eq. 11; NULL for the other schemes),
 	 * each set its own: the soil set's for the solid, the water set's for the water */
 	double *acceleration;       /* [2n] the phase's acceleration at the point, m/s^2 (Eq. 11a-b) */
-	double *volumetric_strain;  /* [n] the phase's volumetric strain since the reference state, eps_v^u
-				       (soil set) or eps_v^U (water set), expansion positive (Eq. 10b) */
-	double *pressure0;          /* [n] water set: the pore pressure of the reference state, p0 of
-				       Eq. 10b, Pa, tension positive like pressure */
 	double *surface;            /* [2n] loaded-face length vector N dA in the reference configuration,
 				       m per m (zero for interior points); see loads.c */
 	int *surface_load;          /* [n] index of the case load acting on the point, -1 if none */
@@ -110,7 +106,7 @@ enum poro_status particles_add_affine(struct particles *p, struct poro_error *er
 /* Gives p an out-of-plane stretch array dF_zz, zeroed. Returns PORO_ENOMEM on failure. */
 enum poro_status particles_add_out_of_plane(struct particles *p, struct poro_error *err);
 
-/* Gives p the implicit scheme's acceleration, volumetric_strain and pressure0 arrays, zeroed.
+/* Gives p the implicit scheme's acceleration array, zeroed.
  * Returns PORO_ENOMEM on failure. */
 enum poro_status particles_add_implicit_state(struct particles *p, struct poro_error *err);
 

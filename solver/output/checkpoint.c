@@ -79,8 +79,6 @@ static const struct saved_array saved_arrays[] = {
 	{"surface_load", MEMBER(surface_load), 1, 1, 0},
 	/* the implicit u-p-U scheme's (NULL, not saved, otherwise); each set owns its own */
 	{"acceleration", MEMBER(acceleration), 2, 0, 1},
-	{"volumetric_strain", MEMBER(volumetric_strain), 1, 0, 1},
-	{"pressure0", MEMBER(pressure0), 1, 0, 1},
 };
 
 #define SAVED_COUNT (sizeof saved_arrays / sizeof saved_arrays[0])

@@ -164,12 +164,11 @@ static const struct compared soil_fields[] = {
 	FIELD(x, 2), FIELD(x0, 2), FIELD(v, 2), FIELD(mass, 1), FIELD(volume, 1), FIELD(volume0, 1),
 	FIELD(porosity, 1), FIELD(porosity0, 1), FIELD(conductivity, 1), FIELD(pressure, 1), FIELD(stress, 4),
 	FIELD(F, 4), FIELD(Be, 4), FIELD(state, STATE_MAX), FIELD(plastic_strain, 1), FIELD(surface, 2),
-	FIELD(acceleration, 2), FIELD(volumetric_strain, 1),
+	FIELD(acceleration, 2),
 };
 static const struct compared water_fields[] = {
 	FIELD(x, 2), FIELD(x0, 2), FIELD(v, 2), FIELD(mass, 1), FIELD(volume, 1), FIELD(volume0, 1),
 	FIELD(porosity, 1), FIELD(porosity0, 1), FIELD(pressure, 1), FIELD(acceleration, 2),
-	FIELD(volumetric_strain, 1), FIELD(pressure0, 1),
 };
 
 static const double *field_of(const struct particles *p, const struct compared *f)

@@ -16,11 +16,12 @@
  *
  * Convergence (spec-001 §4.2; 001 gives no tolerance): an iteration has converged when
  * |delta^k . r^k| <= newton_tolerance |delta^0 . r^0| and the largest displacement correction is
- * at most DISPLACEMENT_TOLERANCE h (the solid's: spec-001 §4.2), or when the residual has fallen to RESIDUAL_FLOOR of the
- * step's force scale (a state already in equilibrium, where the energy of the first iteration is
+ * at most DISPLACEMENT_TOLERANCE h (the solid's: spec-001 §4.2), or when the residual has fallen
+ * to RESIDUAL_FLOOR of the step's force scale (a state already in equilibrium, where the energy of the first iteration is
  * round-off itself). A step that has not converged after newton_max_iterations stops the run with
- * the step, the iteration count and the last energy ratio named (001 gives no cut-back; the run's
- * last checkpoint is the state to resume from with a smaller dt).
+ * the step, the iteration count and the last energy ratio named, exit status 3 (001 gives no
+ * cut-back). The run's last checkpoint is left as it was; it resumes only the case it was written
+ * for, so a smaller dt or the consistent tangent is a new run (tests/cli/newton_failure_test.sh).
  *
  * The tangent: the elastic D of every point (001 A.1f), factorised once a step: the modified
  * Newton-Raphson of 001 §2.2, which converges linearly once points yield; or, with formulation
@@ -127,8 +128,6 @@ static enum poro_status create(struct sim *s)
 		return poro_error_set(&s->err, PORO_ENOMEM, "cannot allocate the implicit scheme's arrays for %ld unknowns "
 				      "and %ld points", (long)N, (long)s->soil.n);
 	e->pressure_scale = pressure_scale(s);
-	/* Eq. 10b's reference pressure: the initial one (a checkpoint, when resuming, restores its own) */
-	memcpy(s->water.pressure0, s->water.pressure, sizeof(double) * (size_t)s->water.n);
 	return PORO_OK;
 }
 
@@ -420,12 +419,9 @@ static enum poro_status update_points(struct sim *s)
 			p->x[2 * q + c] += x_u[c];                                /* (11f) */
 		}
 		moved = fmax(moved, hypot(x_u[0], x_u[1]) * g->inv_h);
-		p->volumetric_strain[q] += eps_u;
 		e->volume_rate[q] = eps_u / dt;
-		if (q < w->n) {
-			w->volumetric_strain[q] += eps_w;
+		if (q < w->n)
 			w->pressure[q] -= e->pressure_increment[q];   /* compression positive increment */
-		}
 	}
 	e->moved_step = moved;
 	/* F from the displacement increment's gradient; V, n, k from B-bar's volumetric strain */

@@ -15,7 +15,12 @@
  *     pp:  -V S_i S_j / Q (-P, the sign spec-001 E2 restores so the matrix is symmetric)
  * and the internal forces of Eq. 10:
  *     f_u,i = V B-bar_i^T (sigma' - (1 - n) p m),   f_U,i = -V n p mB_i,
- *     f_p,i = -V S_i ((1 - n) eps_v^u + (p - p0) / Q + n eps_v^U).
+ *     f_p,i = -V S_i ((1 - n) Delta eps_v^u + Delta p / Q + n Delta eps_v^U),
+ * the last Eq. 3 integrated over the step, with the step's porosity (docs/numerics.md, "Eq. 10b
+ * over a step": spec-001 reconstructs it from the reference state, with the strains accumulated
+ * at the points since t = 0, which is exact only while n and the points' supports stay as they
+ * were, and the Xie-Leo column under 50 kPa blew up when its surface points moved into the next
+ * row of cells).
  * Stress is tension positive with engineering shear; D the elastic matrix (001 A.1f, modified
  * Newton-Raphson) or the materials' tangent.
  *
@@ -264,6 +269,46 @@ void implicit_system_assemble(struct sim *s)
 		}
 }
 
+/* The perturbation of a strain component for the numerical tangent: the forward difference's
+ * truncation error is of order delta |d2 sigma / d eps2| and its round-off of order 1e-16 |sigma| /
+ * delta, both at most about 1e-8 of the tangent at strains of 1e-4 to 1 */
+#define TANGENT_PERTURBATION 1e-8
+
+/* The consistent tangent of a finite-strain material at the iterate, by forward differences: each
+ * column the stress response to a perturbation of one component of the B-bar strain increment,
+ * integrated from the step-start state like the residual's (Miehe 1996, "Numerical computation of
+ * algorithmic (consistent) tangent moduli in large-strain computational inelasticity"). The
+ * materials' own tangent of a finite-strain model is d tau / d eps_trial (material.h), not the
+ * derivative of the Cauchy stress the residual integrates with respect to the linearised strain
+ * increment at x_n (spec-001 §3.4); this is, to about 1e-8. Layout of material.h (tensor shear):
+ * column 2 answers eps_xy, half the engineering shear the strain vector carries. */
+static enum poro_status numerical_tangent(const struct sim *s, idx_t q, const double strain[4], double vol_u,
+					  const struct material *m, int elastic_only, double T[16],
+					  struct poro_error *err)
+{
+	const struct implicit_state *e = implicit_of(s);
+	const struct particles *p = &s->soil;
+	for (int c = 0; c < 4; c++) {
+		double d[4] = {strain[0], strain[1], strain[2], strain[3]};
+		d[c] += TANGENT_PERTURBATION;
+		const double dvol = c == 2 ? 0.0 : TANGENT_PERTURBATION;   /* B-bar: vol = xx + yy + zz */
+		double stress[4], Be[4], state[STATE_MAX], plastic = e->plastic_n[q];
+		memcpy(stress, e->stress_n + 4 * (size_t)q, sizeof stress);
+		memcpy(Be, e->Be_n + 4 * (size_t)q, sizeof Be);
+		memcpy(state, e->state_n + STATE_MAX * (size_t)q, sizeof state);
+		const double dF[4] = {1.0 + d[0], 0.5 * d[2], 0.5 * d[2], 1.0 + d[1]};
+		struct stress_update u = {
+			.dF = dF, .dF_zz = 1.0 + d[3], .J = p->volume[q] / p->volume0[q] * (1.0 + vol_u + dvol),
+			.stress = stress, .Be = Be, .state = state, .plastic_strain = &plastic, .elastic_only = elastic_only,
+		};
+		TRY(material_update(m, &u, err));
+		const double scale = (c == 2 ? 2.0 : 1.0) / TANGENT_PERTURBATION;
+		for (int r = 0; r < 4; r++)
+			T[4 * r + c] = (stress[r] - p->stress[4 * q + r]) * scale;
+	}
+	return PORO_OK;
+}
+
 /* The strain increment of the iterate at point q, B-bar Delta u (xx, yy, engineering xy, zz), and
  * the volumetric strain increments of both phases and the pressure increment there. */
 struct point_increments {
@@ -330,22 +375,25 @@ enum poro_status implicit_system_residual(struct sim *s)
 		memcpy(p->Be + 4 * q, e->Be_n + 4 * (size_t)q, 4 * sizeof(double));
 		memcpy(p->state + STATE_MAX * q, e->state_n + STATE_MAX * (size_t)q, STATE_MAX * sizeof(double));
 		p->plastic_strain[q] = e->plastic_n[q];
+		const struct material *m = &s->materials[s->spec->bodies[p->body[q]].material];
+		const int finite = material_is_finite_strain(m);
 		const double dF[4] = {1.0 + in.strain[0], 0.5 * in.strain[2], 0.5 * in.strain[2], 1.0 + in.strain[1]};
 		struct stress_update u = {
 			.dF = dF, .dF_zz = 1.0 + in.strain[3], .J = p->volume[q] / p->volume0[q] * (1.0 + in.vol_u),
 			.stress = p->stress + 4 * q, .Be = p->Be + 4 * q, .state = p->state + STATE_MAX * q,
-			.plastic_strain = p->plastic_strain + q, .tangent = e->tangent ? e->tangent + 16 * (size_t)q : NULL,
-			.elastic_only = elastic_only,
+			.plastic_strain = p->plastic_strain + q,
+			.tangent = e->tangent && !finite ? e->tangent + 16 * (size_t)q : NULL, .elastic_only = elastic_only,
 		};
-		const struct material *m = &s->materials[s->spec->bodies[p->body[q]].material];
-		struct poro_error err;
-		if (material_update(m, &u, &err) != PORO_OK)
+		struct poro_error err;   /* this point's: the threads' share s->err (keep_lowest_failure) */
+		enum poro_status st = material_update(m, &u, &err);
+		if (!st && e->tangent && finite)
+			st = numerical_tangent(s, q, in.strain, in.vol_u, m, elastic_only, e->tangent + 16 * (size_t)q, &err);
+		if (st)
 			keep_lowest_failure(s, q, &err, &failed);
-		const double pressure = -w->pressure[q] + in.dp, p0 = -w->pressure0[q];   /* compression + */
-		const double eps_u = p->volumetric_strain[q] + in.vol_u, eps_w = w->volumetric_strain[q] + in.vol_w;
+		const double pressure = -w->pressure[q] + in.dp;   /* compression positive */
 		const double *sg = p->stress + 4 * q, pn = (1.0 - ph.n) * pressure;
 		const double partial[4] = {sg[0] - pn, sg[1] - pn, sg[2], sg[3] - pn};   /* sigma' - (1 - n) p m */
-		const double balance = (1.0 - ph.n) * eps_u + (pressure - p0) * ph.inv_Q + ph.n * eps_w;
+		const double balance = (1.0 - ph.n) * in.vol_u + in.dp * ph.inv_Q + ph.n * in.vol_w;
 		const double drag[2] = {ph.drag * (in.v_u[0] - in.v_w[0]), ph.drag * (in.v_u[1] - in.v_w[1])};
 		for (int k = 0; k < o.count; k++) {
 			double *r = e->residual + DOFS_PER_NODE * (size_t)o.node[k];
