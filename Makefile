@@ -8,6 +8,8 @@
 #   make test-san     the service's tests alone under AddressSanitizer + UBSan (docs/service.md §6)
 #   make install [PREFIX=/usr/local] [DESTDIR=]   programs, systemd units, man pages, completions
 #   make uninstall    removes what make install put there
+#   make fuzz [FUZZ_SECONDS=180]   the libFuzzer targets of fuzz/, each for FUZZ_SECONDS (fuzz/fuzz.mk)
+#   make soak [SOAK_JOBS=10000]    the service under random kills (tests/fault/soak.sh)
 # Every public target first runs deploy/deps.sh, which returns at once when nothing is missing.
 # They build with one job per core and print one short line per file ("  CC      build/x.o");
 # V=1 prints the whole commands instead.
@@ -50,6 +52,7 @@ COMMON_TEST_BIN = $(patsubst %.c,$(BUILD)/%,$(wildcard tests/common/*_test.c))
 BENCH_SRC  = $(wildcard bench/*_bench.c)
 BENCH_BIN  = $(BENCH_SRC:%.c=$(BUILD)/%)
 TOOLS      = $(BUILD)/terzaghi-error $(BUILD)/poro-plot
+FAULT_SHIM = $(BUILD)/tests/fault/fault_shim.so
 
 # The service (docs/service.md): server, worker, user CLI and load generator. Each external library
 # enters through one file: libmicrohttpd (server/http.c), SQLite (server/store*.c), libcurl
@@ -58,7 +61,7 @@ COMMON_OBJ = $(patsubst %.c,$(BUILD)/%.o,$(wildcard common/*.c))
 CLIENT_OBJ = $(patsubst %.c,$(BUILD)/%.o,$(wildcard client/*.c))
 SERVER_OBJ = $(patsubst %.c,$(BUILD)/%.o,$(wildcard server/*.c))
 WORKER_OBJ = $(patsubst %.c,$(BUILD)/%.o,$(wildcard worker/*.c))
-SVC_LIBS   = -ljansson -lcrypto -lpthread
+SVC_LIBS   = -ljansson -lcrypto -lpthread -lm
 # poro-server links libporo.a for case validation only, and never HDF5: it does not read result files
 # (probes come from `poro-solve probes`, run by the worker), so a damaged file cannot crash it.
 # tests/service/integrity_test.sh checks with ldd that no libhdf5 is linked.
@@ -66,7 +69,7 @@ SERVER_LIBS = -lmicrohttpd -lsqlite3 -lm $(SVC_LIBS)
 SERVICE    = $(if $(SERVER_OBJ),$(BUILD)/poro-server) $(if $(WORKER_OBJ),$(BUILD)/poro-worker) \
 	     $(if $(CLIENT_OBJ),$(BUILD)/poro $(BUILD)/poro-load)
 
-.PHONY: FORCE all deps run test test-san verify bench clean build-all build-run build-service format install \
+.PHONY: FORCE all deps run test test-san verify bench soak clean build-all build-run build-service format install \
 	install-files build-install uninstall
 .DEFAULT_GOAL := all
 # objects made on the way to a program are kept: deleting them would only rebuild them next time
@@ -78,7 +81,13 @@ deps:
 all: deps
 	@$(MAKE) $(SUBMAKE_FLAGS) build-all
 
-build-all: $(POROSOLVE) $(TEST_BIN) $(COMMON_TEST_BIN) $(BENCH_BIN) $(TOOLS) $(SERVICE)
+build-all: $(POROSOLVE) $(TEST_BIN) $(COMMON_TEST_BIN) $(BENCH_BIN) $(TOOLS) $(SERVICE) $(FAULT_SHIM)
+
+# The fault and power-loss tests' LD_PRELOAD library (tests/fault/fault_shim.c): never sanitized,
+# since it is loaded into other programs.
+$(FAULT_SHIM): tests/fault/fault_shim.c
+	@mkdir -p $(dir $@)
+	$(call quiet,CC)$(CC) -std=c11 -D_POSIX_C_SOURCE=200809L $(OPT) -g $(WARN) -fPIC -shared $< -ldl -o $@
 
 # What tests/run_example.sh runs: the server, a worker, the poro CLI, the solver and the error
 # against Terzaghi's closed form; no test program.
@@ -110,6 +119,13 @@ bench: deps
 	@$(MAKE) $(SUBMAKE_FLAGS) build-all
 	@bash bench/run.sh $(BUILD)
 
+# The soak (docs/hardening.md): SOAK_JOBS short jobs while the server and workers are killed at
+# random; make test runs a few hundred of them (tests/fault/soak_test.sh).
+SOAK_JOBS ?= 10000
+soak: deps
+	@$(MAKE) $(SUBMAKE_FLAGS) build-all
+	@bash tests/fault/soak.sh $(BUILD) $(SOAK_JOBS)
+
 $(BUILD)/%.o: %.c $(SOLVER_HDR) $(wildcard tests/*.h tests/verify/*.h common/*.h client/*.h server/*.h worker/*.h)
 	@mkdir -p $(dir $@)
 	$(call quiet,CC)$(CC) $(CPPFLAGS) -Icommon -Iclient $(CFLAGS) -c $< -o $@
@@ -134,7 +150,7 @@ $(POROSOLVE): $(BUILD)/cli/poro_solve.o $(LIBPORO)
 $(BUILD)/terzaghi-error: $(BUILD)/tools/terzaghi_error.o $(LIBPORO)
 	$(call quiet,LD)$(CC) $(LDFLAGS) $^ $(LDLIBS) -o $@
 
-$(BUILD)/tools/terzaghi_error.o: tests/verify/analytic.h
+$(BUILD)/tools/terzaghi_error.o: solver/verify/analytic.h
 
 # poro-plot is a Python program (matplotlib, h5py): "built" by copying it beside poro-solve, which
 # it calls for the run-out picture.
@@ -161,7 +177,9 @@ $(BUILD)/poro-worker: $(WORKER_OBJ) $(CLIENT_OBJ) $(COMMON_OBJ)
 PORO_CLI_OBJ = $(patsubst %.c,$(BUILD)/%.o,$(wildcard cli/poro/*.c))
 $(BUILD)/cli/poro.o $(PORO_CLI_OBJ): $(wildcard cli/poro/*.h)
 
-$(BUILD)/poro: $(BUILD)/cli/poro.o $(PORO_CLI_OBJ) $(CLIENT_OBJ) $(COMMON_OBJ)
+# poro nightly checks a suite's figures against the solver's own table of them (figures.o, which
+# needs nothing else of the solver)
+$(BUILD)/poro: $(BUILD)/cli/poro.o $(PORO_CLI_OBJ) $(CLIENT_OBJ) $(COMMON_OBJ) $(BUILD)/solver/verify/figures.o
 	$(call quiet,LD)$(CC) $(LDFLAGS) $^ -lcurl $(SVC_LIBS) -lm -o $@
 
 $(BUILD)/poro-load: $(BUILD)/bench/poro_load.o $(CLIENT_OBJ) $(COMMON_OBJ)
@@ -210,7 +228,7 @@ install-files:
 	install -m 644 deploy/worker.env.example $(DESTDIR)$(DATADIR)/poro/examples/worker.env
 	[ -e $(DESTDIR)$(SYSCONFDIR)/poro/poro-server.conf ] || \
 		install -m 644 deploy/poro-server.conf.example $(DESTDIR)$(SYSCONFDIR)/poro/poro-server.conf
-	if [ -d web ]; then install -d $(DESTDIR)$(DATADIR)/poro/web && cp -R web/. $(DESTDIR)$(DATADIR)/poro/web/; fi
+	if [ -d web ]; then install -d $(DESTDIR)$(DATADIR)/poro/web && cp -RL web/. $(DESTDIR)$(DATADIR)/poro/web/; fi
 
 uninstall:
 	rm -f $(addprefix $(DESTDIR)$(BINDIR)/,$(INSTALL_BIN)) $(addprefix $(DESTDIR)$(UNITDIR)/,$(UNITS)) \
@@ -227,4 +245,6 @@ format:
 	git clang-format --force $(FORMAT_BASE) -- '*.c' '*.h'
 
 clean:
-	rm -rf build build-san
+	rm -rf build build-san build-fuzz
+
+include fuzz/fuzz.mk

@@ -57,3 +57,5 @@ get "deep page, after=$deep, 100" "$bulk" "/v1/jobs?after=$deep&limit=100" 1 "$R
 get "64 concurrent clients, user with 10 jobs" "$small" "/v1/jobs" 64 $((64 * REQUESTS / 4))
 curl -s -H "Authorization: Bearer $admin" "$url/metrics" | grep '^poro_job_list' | tr '\n' ' ' | sed 's/^/listing cost counters: /'
 echo
+# the dashboard's search and its jobs page, on the same 100,000 jobs (bench/web.sh)
+WEB_URL=$url WEB_ADMIN=$admin WEB_USER=$bulk WEB_SMALL=small bash bench/web.sh "$build"

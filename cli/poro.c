@@ -11,6 +11,7 @@
  *   poro rm [--json] ID
  *   poro fetch ID [--out DIR] [--file NAME]...
  *   poro token ls [--json] | poro token revoke [--json] ID
+ *   poro nightly run|show|compare|ls|report ...   (cli/poro/nightly.c)
  *   poro --help | --version
  *
  * This file holds the command table, the help and main(); the commands are in cli/poro/ (cli.h).
@@ -89,6 +90,28 @@ static const struct subcommand COMMANDS[] = {
 	  "refused from its next request on.\n"
 	  "  -j, --json               print the tokens or the revoked token as the API answers\n",
 	  cmd_token },
+	{ "nightly",
+	  "nightly run SUITE.json [--label L] [--commit C] [--only CASE]... [--junit FILE] [--html FILE] [--json]\n"
+	  "                   | nightly show [ID] [--json] | nightly compare A B [--json]\n"
+	  "                   | nightly ls [--suite S] [--limit N] [--json] | nightly report ID [--junit FILE] [--html FILE]\n"
+	  "                   | nightly check SUITE.json [--out DIR] [--only CASE]...",
+	  "Benchmark nightlies (docs/benchmarks.md). run submits a suite's cases as one batch of jobs (those\n"
+	  "timed against history run alone on a worker), follows them with a progress bar, has the server\n"
+	  "judge every figure (accuracy against its band, timing by a rank test against the same machine's\n"
+	  "recent runs) and prints the verdicts; exit 0 when the run passed, 9 when a figure regressed,\n"
+	  "failed or did not run. show prints a run (the latest without ID), compare two side by side (timings\n"
+	  "of two machines are not compared), ls the runs, report writes a run's reports, check reads a\n"
+	  "suite without a server and prints what run would submit.\n"
+	  "  -l, --label L            the batch label of the run's jobs (default SUITE-TIME-RANDOM)\n"
+	  "  -c, --commit C           what the run is of (default: git describe of the suite's checkout)\n"
+	  "  -o, --only CASE          run (or check) only this case of the suite; repeatable\n"
+	  "      --out DIR            check: write each case as it would be submitted into DIR/CASE.json\n"
+	  "      --junit FILE         write the run's JUnit XML (any CI reads it)\n"
+	  "      --html FILE          write a self-contained HTML report, one plot per figure over the runs\n"
+	  "  -s, --suite S            ls: only the runs of suite S\n"
+	  "  -n, --limit N            ls: 1..1000 (20) runs, newest first\n"
+	  "  -j, --json               print the API's objects\n",
+	  cmd_nightly },
 };
 #define COMMAND_COUNT ((int)(sizeof COMMANDS / sizeof COMMANDS[0]))
 

@@ -2,12 +2,15 @@
  * poro_solve.c - the poro-solve command: the solver library behind a command line.
  *
  *   poro-solve run CASE.json --out DIR [--resume CHECKPOINT] [--checkpoint-wall SECONDS]
- *                                        run a case, write DIR/result.h5 and DIR/result.xdmf
+ *                                        run a case, write DIR/result.h5 and DIR/result.xdmf, and at
+ *                                        the end DIR/metrics.json (metrics.h: the run's figures, also
+ *                                        in result.h5's /metrics); an element case runs as `element`,
+ *                                        with a result.h5 that holds its figures
  *   poro-solve validate CASE.json        check a case (a simulation case, or an element case by its
  *                                        "schema"); every problem as "JSON-pointer: message"
  *   poro-solve element CASE.json --out DIR
  *                                        single-element triaxial test (element.h, docs/element.md):
- *                                        DIR/element.csv (poro-plot draws it)
+ *                                        DIR/element.csv (poro-plot draws it), DIR/metrics.json
  *   poro-solve report RESULT.h5 [--out FILE] [--ground Y] [--crest X] [--tolerance M]
  *                     [--line X0,Y0,X1,Y1[,...][,N] --line-out FILE [--at TIME]]
  *                                        derived quantities of a run (report.h, docs/report.md): a
@@ -20,6 +23,10 @@
  *                                        service serves (docs/service.md §3, GET .../probes):
  *                                        {"job", "attempt", "probes": {name: {"unit", "time",
  *                                        "value"}}}, names in the order of the case, to stdout or FILE
+ *   poro-solve frames RESULT.h5 --out DIR [--job ID --attempt N]
+ *                                        every frame in the dashboard's compact form: DIR/frames.bin
+ *                                        and its index DIR/frames.json (frames_export.h); probes
+ *                                        --frames DIR writes the same beside the probes
  *   poro-solve version | --version | --help;  poro-solve COMMAND --help
  *
  * Options are parsed by getopt_long, with GNU habits: "--out DIR" and "--out=DIR", options before
@@ -30,12 +37,17 @@
  * --checkpoint-wall seconds of wall time, whichever comes first, and prints
  * "checkpoint step=N time=T" after each; --resume continues from such a checkpoint, keeping the
  * frames of DIR/result.h5 up to it (checkpoint.h, docs/service.md §2). A checkpoint of another
- * case is refused with exit 2, naming the first difference.
+ * case is refused with exit 2, naming the first difference. SIGUSR1 writes a checkpoint of the
+ * current step and stops (exit 6), SIGTERM and SIGINT stop without one.
  *
  * probes runs in its own process because a result file is untrusted input for whoever reads it: the
  * worker runs it on each result.h5 it uploads, so a damaged file can crash only this process, never
  * the server (which no longer links HDF5). Numbers are written with 17 significant digits, so they
  * read back to the same doubles; a value that is not finite is written as null (JSON has no NaN).
+ *
+ * The test knob PORO_DEBUG_SLOWDOWN=F (F in (1, 100]) makes each step of `run` cost about F times
+ * as much, results unchanged (sim_set_slowdown; docs/benchmarks.md, "Test knobs"): the benchmark
+ * tests' stand-in for a slower solver.
  *
  * Exit codes come from the status table in error.h: 0 success, 2 invalid input, 3 solver failure
  * (NaN, a point leaving the grid, a failed factorisation), 4 I/O, 5 out of memory, 6 interrupted.
@@ -49,10 +61,16 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
+#include <time.h>
 
 #include "case.h"
 #include "checkpoint.h"
 #include "element.h"
+#include "frames_export.h"
+#include "json_text.h"
+#include "metrics.h"
+#include "output.h"
 #include "poro.h"
 #include "report.h"
 #include "results_read.h"
@@ -64,10 +82,11 @@
 
 static volatile int stop_requested;
 
+/* SIGTERM, SIGINT: stop. SIGUSR1: write a checkpoint of the current step, then stop (a worker
+ * handing its job back before its allocation ends). */
 static void on_signal(int sig)
 {
-	(void)sig;
-	stop_requested = 1;
+	stop_requested = sig == SIGUSR1 ? SIM_STOP_CHECKPOINT : 1;
 }
 
 #define PROGRAM "poro-solve"
@@ -79,12 +98,15 @@ static int parse_validate(const struct subcommand *self, int argc, char **argv);
 static int parse_element(const struct subcommand *self, int argc, char **argv);
 static int parse_report(const struct subcommand *self, int argc, char **argv);
 static int parse_probes(const struct subcommand *self, int argc, char **argv);
+static int parse_frames(const struct subcommand *self, int argc, char **argv);
 static int parse_version(const struct subcommand *self, int argc, char **argv);
 
 static const struct subcommand COMMANDS[] = {
 	{ "run", "run CASE.json --out DIR [--resume CHECKPOINT] [--checkpoint-wall SECONDS]",
 	  "Runs a case; writes DIR/result.h5 and DIR/result.xdmf, and DIR/checkpoint.h5 every\n"
-	  "checkpoint.interval of simulated time and every --checkpoint-wall seconds of wall time.\n"
+	  "checkpoint.interval of simulated time and every --checkpoint-wall seconds of wall time; at the\n"
+	  "end DIR/metrics.json, the run's figures (also in result.h5's /metrics). An element case\n"
+	  "(\"schema\": \"poro-element/1\") runs as `element` does, with a result.h5 of its figures.\n"
 	  "  -o, --out DIR                 the output directory (required)\n"
 	  "      --resume CHECKPOINT       continue from a checkpoint of the same case, keeping the\n"
 	  "                                frames of DIR/result.h5 up to it\n"
@@ -95,7 +117,8 @@ static const struct subcommand COMMANDS[] = {
 	  "'JSON-pointer: message' on stderr, exit 2 when there is one.\n",
 	  parse_validate },
 	{ "element", "element CASE.json --out DIR",
-	  "A single-element triaxial test (docs/element.md): DIR/element.csv, which poro-plot draws.\n"
+	  "A single-element triaxial test (docs/element.md): DIR/element.csv, which poro-plot draws,\n"
+	  "and DIR/metrics.json, its figures.\n"
 	  "  -o, --out DIR                 the output directory (required)\n",
 	  parse_element },
 	{ "report", "report RESULT.h5 [--out FILE] [--ground Y] [--crest X] [--tolerance M]\n"
@@ -110,12 +133,19 @@ static const struct subcommand COMMANDS[] = {
 	  "      --line-out FILE           the table of the line (needed with --line)\n"
 	  "      --at TIME                 the time of the line's frame, s\n",
 	  parse_report },
-	{ "probes", "probes RESULT.h5 --job ID --attempt N [--out FILE]",
+	{ "probes", "probes RESULT.h5 --job ID --attempt N [--out FILE] [--frames DIR]",
 	  "The probe series of a run as the JSON document the job service serves (docs/service.md §3):\n"
 	  "{\"job\", \"attempt\", \"probes\": {name: {\"unit\", \"time\", \"value\"}}}, to stdout or FILE.\n"
 	  "      --job ID, --attempt N     the job and attempt the document names (whole numbers >= 0)\n"
-	  "  -o, --out FILE                where to write it (nothing is left there on failure)\n",
+	  "  -o, --out FILE                where to write it (nothing is left there on failure)\n"
+	  "      --frames DIR              also write DIR/frames.bin and DIR/frames.json (as 'frames')\n",
 	  parse_probes },
+	{ "frames", "frames RESULT.h5 --out DIR [--job ID --attempt N]",
+	  "Every frame of a run in the dashboard's compact form (docs/web.md, \"Frames\"): DIR/frames.bin,\n"
+	  "the points' positions and fields as 32-bit floats, and its index DIR/frames.json.\n"
+	  "  -o, --out DIR                 the directory to write them in (required)\n"
+	  "      --job ID, --attempt N     the job and attempt the index names (default 0)\n",
+	  parse_frames },
 	{ "version", "version", "Prints \"poro-solve VERSION\" (git describe of the build).\n", parse_version },
 };
 static const int COMMAND_COUNT = (int)(sizeof COMMANDS / sizeof COMMANDS[0]);
@@ -195,20 +225,98 @@ static int cmd_validate(const char *path)
 	return 0;
 }
 
+/* Processor time of this process, s (every thread). */
+static double cpu_seconds(void)
+{
+	struct timespec ts;
+	clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
+	return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+static double wall_seconds(void)
+{
+	struct timespec ts;
+	clock_gettime(CLOCK_MONOTONIC, &ts);
+	return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+/* Writes DIR/metrics.json and result.h5's /metrics (metrics.h); 0, or the exit status of an I/O
+ * failure after saying so. */
+static int write_metrics(const struct metrics *m, const char *out_dir)
+{
+	struct poro_error err = {0};
+	enum poro_status st = metrics_write(m, out_dir, &err);
+	return st ? fail(st, &err, out_dir) : 0;
+}
+
+/* The whole text of a file, or NULL (errno set). The caller frees it. */
+static char *read_text(const char *path)
+{
+	FILE *f = fopen(path, "rb");
+	char *text = NULL, buf[8192];
+	size_t n = 0, cap = 0, got;
+	while (f && (got = fread(buf, 1, sizeof buf, f)) > 0) {
+		if (n + got + 1 > cap) {
+			char *grown = realloc(text, cap = 2 * (n + got + 1));
+			if (!grown)
+				break;
+			text = grown;
+		}
+		memcpy(text + n, buf, got);
+		n += got;
+		text[n] = '\0';
+	}
+	if (f)
+		fclose(f);
+	return text;
+}
+
+/* An element run's result.h5: the case, /run (status, steps, wall time) and no frames, so that the
+ * job service, which requires a result.h5 of every successful job, takes element tests too (the
+ * figures go into its /metrics next). */
+static enum poro_status element_result_file(const char *path, const char *out_dir, int ok, long steps,
+					    double wall, struct poro_error *err)
+{
+	char *json = read_text(path);
+	if (!json)
+		return poro_error_set(err, PORO_EIO, "cannot read '%s': %s", path, strerror(errno));
+	const char *none[1] = { NULL };
+	struct output *o = NULL;
+	enum poro_status st = output_create(&o, out_dir, json, PORO_VERSION, 0, none, none, err);
+	if (!st)
+		st = output_finish(o, ok ? "succeeded" : "failed", steps, 1, wall, err);
+	output_destroy(&o);
+	free(json);
+	return st;
+}
+
 /* element CASE.json --out DIR: an element case (its own schema, "poro-element/1") through the
- * single-element driver. */
-static int cmd_element(const char *path, const char *out_dir)
+ * single-element driver: DIR/element.csv and DIR/metrics.json, and with result_file (what `run`
+ * does with an element case) DIR/result.h5, which holds the figures too. */
+static int cmd_element(const char *path, const char *out_dir, int result_file)
 {
 	struct element_case c;
 	struct element_result r = {0};
-	struct poro_error err = {0};
+	struct poro_error err = {0}, io = {0};
 	enum poro_status st = element_case_load_file(path, &c, &err);
 	if (st)
 		return fail(st, &err, path);
 	print_warnings(path, c.warnings);
+	if (mkdir(out_dir, 0777) && errno != EEXIST) {
+		poro_error_set(&io, PORO_EIO, "cannot create output directory '%s': %s", out_dir, strerror(errno));
+		return fail(PORO_EIO, &io, path);
+	}
+	double w0 = wall_seconds(), c0 = cpu_seconds();
 	st = element_run(&c, &r, &err);
+	double wall = wall_seconds() - w0, cpu = cpu_seconds() - c0;
+	struct metrics m;
+	metrics_init(&m, "element", c.title, PORO_VERSION);
+	metrics_of_element(&m, &c, &r, wall, cpu, st ? err.message : NULL);
+	enum poro_status ran = st;
 	if (!st)
 		st = element_write(&c, &r, out_dir, &err);
+	enum poro_status io_st = result_file ? element_result_file(path, out_dir, !ran, r.rows - 1, wall, &io) : PORO_OK;
+	int code = io_st ? fail(io_st, &io, out_dir) : write_metrics(&m, out_dir);
 	if (st) {
 		element_result_release(&r);
 		return fail(st, &err, path);
@@ -216,9 +324,11 @@ static int cmd_element(const char *path, const char *out_dir)
 	const struct element_row *last = &r.row[r.rows - 1];
 	printf("%d steps: axial strain %.6g, p = %.6g Pa, q = %.6g Pa, volumetric strain %.6g\n", r.rows - 1,
 	       last->axial_strain, last->p, last->q, last->volumetric_strain);
-	printf("done: %s/element.csv (pictures: poro-plot %s/element.csv)\n", out_dir, out_dir);
+	if (!code)
+		printf("done: %s/element.csv (pictures: poro-plot %s/element.csv), %s/%s\n", out_dir, out_dir, out_dir,
+		       METRICS_FILE);
 	element_result_release(&r);
-	return 0;
+	return code;
 }
 
 /* text as a whole finite number into *value; -1 when it is not one. */
@@ -236,12 +346,41 @@ struct run_options {
 	double checkpoint_wall;     /* s of wall time between checkpoints, 0 = none */
 };
 
+/* The test knob PORO_DEBUG_SLOWDOWN (sim_set_slowdown, docs/benchmarks.md "Test knobs"): unset, or a
+ * factor in (1, 100]. 0 with *factor set (1 when unset), or -1 after saying why not. */
+static int slowdown_knob(double *factor)
+{
+	const char *text = getenv("PORO_DEBUG_SLOWDOWN");
+	*factor = 1;
+	if (!text || !*text)
+		return 0;
+	if (parse_number(text, factor) || !(*factor > 1) || *factor > 100) {
+		fprintf(stderr, "poro-solve: PORO_DEBUG_SLOWDOWN='%s' is not a factor in (1, 100]\n", text);
+		return -1;
+	}
+	printf("test knob PORO_DEBUG_SLOWDOWN=%g: each step repeats its shape functions to cost about %gx "
+	       "(results unchanged)\n", *factor, *factor);
+	return 0;
+}
+
+/* run on a simulation case: result.h5, result.xdmf, checkpoints, and metrics.json when the run
+ * ends (succeeded, or failed in a step; not when it is interrupted: a resumed run writes them). An
+ * element case goes to the element driver, with a result.h5 (cmd_element). */
 static int cmd_run(const char *path, const struct run_options *opt)
 {
 	const char *out_dir = opt->out_dir;
 	struct case_spec *c = NULL;
 	struct sim *s = NULL;
 	struct poro_error err = {0};
+	double slowdown;
+	if (element_case_file_is_element(path)) {
+		if (!opt->resume)
+			return cmd_element(path, out_dir, 1);
+		return fail(poro_error_set(&err, PORO_EINVAL, "an element test has no checkpoint to resume from"), &err,
+			    opt->resume);
+	}
+	if (slowdown_knob(&slowdown))
+		return poro_status_exit_code(PORO_EINVAL);
 	enum poro_status st = case_load_file(path, &c, &err);
 	if (st)
 		return fail(st, &err, path);
@@ -258,6 +397,7 @@ static int cmd_run(const char *path, const struct run_options *opt)
 		return code;
 	}
 	sim_set_checkpoint_wall(s, opt->checkpoint_wall);
+	sim_set_slowdown(s, slowdown);
 	printf("case '%s': %ld soil points, %ld water points, %ld steps\n", c->title,
 	       (long)sim_soil(s)->n, sim_is_double_point(s) ? (long)sim_water(s)->n : 0L, sim_steps_total(s));
 	if (c->time.dt_auto)
@@ -267,14 +407,21 @@ static int cmd_run(const char *path, const struct run_options *opt)
 		printf("resumed from '%s' at step %ld, t = %.6g s\n", opt->resume, sim_steps_taken(s), sim_time(s));
 	signal(SIGTERM, on_signal);
 	signal(SIGINT, on_signal);
+	signal(SIGUSR1, on_signal);
 	st = sim_run(s, out_dir, PORO_VERSION, print_progress, NULL, &stop_requested);
 	if (!st && sim_warning(s))   /* a failure's message quotes it already (step_health.c) */
 		printf("warning: %s\n", sim_warning(s));
 	int code = 0;
+	if (st == PORO_OK || st == PORO_ESOLVER) {
+		struct metrics m;
+		metrics_init(&m, "simulation", c->title, PORO_VERSION);
+		metrics_of_run(&m, s, c, out_dir, st ? sim_error(s)->message : NULL);
+		code = write_metrics(&m, out_dir);
+	}
 	if (st)
 		code = fail(st, sim_error(s), path);
-	else
-		printf("done: %s/result.h5\n", out_dir);
+	else if (!code)
+		printf("done: %s/result.h5, %s/%s\n", out_dir, out_dir, METRICS_FILE);
 	sim_destroy(&s);
 	case_destroy(&c);
 	return code;
@@ -336,7 +483,7 @@ static int parse_element(const struct subcommand *self, int argc, char **argv)
 	}
 	if ((rc = subcommand_positional(PROGRAM, self, argc, argv, 1, "CASE.json")))
 		return rc;
-	return out ? cmd_element(argv[optind], out) : subcommand_usage_error(PROGRAM, self, "missing --out DIR");
+	return out ? cmd_element(argv[optind], out, 0) : subcommand_usage_error(PROGRAM, self, "missing --out DIR");
 }
 
 static int parse_version(const struct subcommand *self, int argc, char **argv)
@@ -463,44 +610,6 @@ static int parse_report(const struct subcommand *self, int argc, char **argv)
 
 /* ---- probes ---------------------------------------------------------------------------------- */
 
-/* Writes text as a JSON string. Probe names come from the case, which jansson has read, so they are
- * valid UTF-8; units are the solver's ASCII names, and any other byte in them is a damaged file's,
- * written as '?' so the document stays valid UTF-8 whatever the file holds. */
-static void write_json_string(FILE *f, const char *text, int ascii_only)
-{
-	fputc('"', f);
-	for (const unsigned char *p = (const unsigned char *)text; *p; p++) {
-		if (*p == '"' || *p == '\\')
-			fprintf(f, "\\%c", *p);
-		else if (*p < 0x20)
-			fprintf(f, "\\u%04x", *p);
-		else
-			fputc(ascii_only && *p >= 0x7f ? '?' : *p, f);
-	}
-	fputc('"', f);
-}
-
-static void write_json_numbers(FILE *f, const double *x, long n)
-{
-	fputc('[', f);
-	for (long k = 0; k < n; k++) {
-		if (k)
-			fputc(',', f);
-		if (!isfinite(x[k])) {
-			fputs("null", f);
-			continue;
-		}
-		char text[32];   /* the shortest of 15, 16, 17 digits that reads back to x[k] */
-		for (int digits = 15; digits <= 17; digits++) {
-			snprintf(text, sizeof text, "%.*g", digits, x[k]);
-			if (strtod(text, NULL) == x[k])
-				break;
-		}
-		fputs(text, f);
-	}
-	fputc(']', f);
-}
-
 /* The "probes" object: each probe of the case, in its order, read from the file. */
 static enum poro_status write_probes(FILE *f, struct results *res, const struct case_spec *c,
 				     struct poro_error *err)
@@ -515,13 +624,13 @@ static enum poro_status write_probes(FILE *f, struct results *res, const struct 
 			return st;
 		if (i)
 			fputs(", ", f);
-		write_json_string(f, c->probes[i].name, 0);
+		json_text_string(f, c->probes[i].name, 0);   /* jansson read it: valid UTF-8 */
 		fputs(": {\"unit\": ", f);
-		write_json_string(f, units ? units : "", 1);
+		json_text_string(f, units ? units : "", 1);   /* the file may be damaged */
 		fputs(", \"time\": ", f);
-		write_json_numbers(f, t, n);
+		json_text_numbers(f, t, n);
 		fputs(", \"value\": ", f);
-		write_json_numbers(f, v, n);
+		json_text_numbers(f, v, n);
 		fputc('}', f);
 		free(t), free(v), free(units);
 	}
@@ -530,8 +639,10 @@ static enum poro_status write_probes(FILE *f, struct results *res, const struct 
 }
 
 /* probes RESULT.h5: the whole document, or nothing (an --out FILE is removed) when the file cannot be
- * read. The case comes from the file itself, so its probe order is the run's. */
-static int cmd_probes(const char *path, long long job, long long attempt, const char *out)
+ * read. The case comes from the file itself, so its probe order is the run's. FILE is written as
+ * FILE.tmp and renamed, so it is whole whenever it exists: a worker that had to kill this process
+ * while it wrote the frames after it still has complete probes. */
+static int cmd_probes(const char *path, long long job, long long attempt, const char *out, const char *frames)
 {
 	struct poro_error err = {0};
 	struct results *res = NULL;
@@ -539,28 +650,46 @@ static int cmd_probes(const char *path, long long job, long long attempt, const 
 	enum poro_status st = results_check_file(path, &err);
 	if (!st)
 		st = results_open(&res, path, &err);
-	if (!st)
+	struct element_case element;
+	struct poro_error ignored = {0};
+	/* an element test's result.h5 (run on an element case) has no probes: an empty set */
+	int is_element = !st && element_case_load_string(results_case_json(res), &element, &ignored) == PORO_OK;
+	if (!st && !is_element)
 		st = case_load_string(results_case_json(res), &c, &err);
 	FILE *f = NULL;
-	if (!st && !(f = out ? create_output(out) : stdout)) {
+	char tmp[4200] = "";
+	if (out)
+		snprintf(tmp, sizeof tmp, "%s.tmp", out);
+	if (!st && !(f = out ? create_output(tmp) : stdout)) {
 		results_close(&res);
 		case_destroy(&c);
 		return poro_status_exit_code(PORO_EIO);
 	}
 	if (!st) {
 		fprintf(f, "{\"job\": %lld, \"attempt\": %lld, ", job, attempt);
-		st = write_probes(f, res, c, &err);
+		if (is_element)
+			fputs("\"probes\": {}", f);
+		else
+			st = write_probes(f, res, c, &err);
 		fputs("}\n", f);
 		if (!st && (fflush(f) != 0 || ferror(f)))
 			st = poro_error_set(&err, PORO_EIO, "cannot write '%s': %s", out ? out : "stdout", strerror(errno));
 	}
 	if (out && f && fclose(f) != 0 && !st)
-		st = poro_error_set(&err, PORO_EIO, "cannot write '%s': %s", out, strerror(errno));
+		st = poro_error_set(&err, PORO_EIO, "cannot write '%s': %s", tmp, strerror(errno));
+	if (!st && out && f && rename(tmp, out) != 0)
+		st = poro_error_set(&err, PORO_EIO, "cannot rename '%s' to '%s': %s", tmp, out, strerror(errno));
 	if (st && out && f)
-		remove(out);
+		remove(tmp);
 	results_close(&res);
 	case_destroy(&c);
-	return st ? fail(st, &err, path) : 0;
+	if (st)
+		return fail(st, &err, path);
+	/* the frames are the dashboard's and do not hold up the probes: a failure is said, and the
+	 * probes stand (frames_export leaves no frames file behind) */
+	if (frames && (st = frames_export(path, frames, job, attempt, &err)))
+		fprintf(stderr, "poro-solve: no frames written in '%s': %s\n", frames, err.message);
+	return 0;
 }
 
 /* An integer option value in [0, 10^18]; -1 after saying why not. */
@@ -576,32 +705,62 @@ static int parse_count(const char *key, const char *text, long long *value)
 	return 0;
 }
 
-/* probes RESULT.h5 --job ID --attempt N [--out FILE]. */
-static int parse_probes(const struct subcommand *self, int argc, char **argv)
+/* The options of probes and frames: --job, --attempt, --out and (probes) --frames; 0, -1 after
+ * printing the help (exit 0), or an exit status after saying why. */
+struct extract_options {
+	long long job, attempt;
+	const char *out, *frames;
+};
+
+static int parse_extract(const struct subcommand *self, int argc, char **argv, int with_frames,
+			 struct extract_options *o)
 {
 	static const struct option opts[] = {
 		{ "job", required_argument, NULL, 'j' }, { "attempt", required_argument, NULL, 'a' },
-		{ "out", required_argument, NULL, 'o' }, { "help", no_argument, NULL, 'h' }, { NULL, 0, NULL, 0 }
+		{ "out", required_argument, NULL, 'o' }, { "frames", required_argument, NULL, 'f' },
+		{ "help", no_argument, NULL, 'h' }, { NULL, 0, NULL, 0 }
 	};
-	long long job = -1, attempt = -1;
-	const char *out = NULL;
-	int c, rc;
+	int c;
 	while ((c = getopt_long(argc, argv, "ho:", opts, NULL)) != -1) {
 		if (c == 'h')
-			return subcommand_help(PROGRAM, self);
+			return subcommand_help(PROGRAM, self) == 0 ? -1 : 2;
 		else if (c == 'o')
-			out = optarg;
+			o->out = optarg;
+		else if (c == 'f' && with_frames)
+			o->frames = optarg;
 		else if (c == 'j' || c == 'a') {
-			if (parse_count(c == 'j' ? "--job" : "--attempt", optarg, c == 'j' ? &job : &attempt))
+			if (parse_count(c == 'j' ? "--job" : "--attempt", optarg, c == 'j' ? &o->job : &o->attempt))
 				return 2;
 		} else
 			return subcommand_usage_error(PROGRAM, self, NULL);
 	}
-	if ((rc = subcommand_positional(PROGRAM, self, argc, argv, 1, "RESULT.h5")))
-		return rc;
-	if (job < 0 || attempt < 0)
-		return subcommand_usage_error(PROGRAM, self, "missing %s", job < 0 ? "--job ID" : "--attempt N");
-	return cmd_probes(argv[optind], job, attempt, out);
+	return subcommand_positional(PROGRAM, self, argc, argv, 1, "RESULT.h5");
+}
+
+/* probes RESULT.h5 --job ID --attempt N [--out FILE] [--frames DIR]. */
+static int parse_probes(const struct subcommand *self, int argc, char **argv)
+{
+	struct extract_options o = { -1, -1, NULL, NULL };
+	int rc = parse_extract(self, argc, argv, 1, &o);
+	if (rc)
+		return rc < 0 ? 0 : rc;
+	if (o.job < 0 || o.attempt < 0)
+		return subcommand_usage_error(PROGRAM, self, "missing %s", o.job < 0 ? "--job ID" : "--attempt N");
+	return cmd_probes(argv[optind], o.job, o.attempt, o.out, o.frames);
+}
+
+/* frames RESULT.h5 --out DIR [--job ID --attempt N]. */
+static int parse_frames(const struct subcommand *self, int argc, char **argv)
+{
+	struct extract_options o = { 0, 0, NULL, NULL };
+	int rc = parse_extract(self, argc, argv, 0, &o);
+	if (rc)
+		return rc < 0 ? 0 : rc;
+	if (!o.out)
+		return subcommand_usage_error(PROGRAM, self, "missing --out DIR");
+	struct poro_error err = { 0 };
+	enum poro_status st = frames_export(argv[optind], o.out, o.job, o.attempt, &err);
+	return st ? fail(st, &err, argv[optind]) : 0;
 }
 
 int main(int argc, char **argv)

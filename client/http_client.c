@@ -55,6 +55,13 @@ void http_global_cleanup(void)
 	curl_global_cleanup();
 }
 
+static char ca_file_path[1024]; /* "" for the system's authorities; set before threads start */
+
+void http_global_ca_file(const char *ca_file)
+{
+	snprintf(ca_file_path, sizeof ca_file_path, "%s", ca_file ? ca_file : "");
+}
+
 struct http_client *http_client_create(const char *server, const char *token)
 {
 	struct http_client *c = calloc(1, sizeof *c);
@@ -111,7 +118,8 @@ int http_ok(const struct http_response *r)
 
 int http_transient(const struct http_response *r)
 {
-	return r->status == 0 || r->status >= 500 || r->status == 408 || r->status == 429;
+	/* an unverifiable certificate is a setting to fix: asking again gets the same answer */
+	return (r->status == 0 && !r->tls_unverified) || r->status >= 500 || r->status == 408 || r->status == 429;
 }
 
 const char *http_describe(const struct http_response *r, char *buf, size_t size)
@@ -259,6 +267,8 @@ static void setup(struct http_client *c, struct transfer *t, const char *path, l
 	if (timeout_seconds > 0)
 		curl_easy_setopt(h, CURLOPT_TIMEOUT, timeout_seconds);
 	curl_easy_setopt(h, CURLOPT_TCP_KEEPALIVE, 1L);
+	if (ca_file_path[0])
+		curl_easy_setopt(h, CURLOPT_CAINFO, ca_file_path);
 	curl_easy_setopt(h, CURLOPT_WRITEFUNCTION, on_write);
 	curl_easy_setopt(h, CURLOPT_WRITEDATA, t);
 	curl_easy_setopt(h, CURLOPT_HEADERFUNCTION, on_header);
@@ -295,6 +305,10 @@ static long perform(struct transfer *t, struct curl_slist *headers)
 			snprintf(r->error, sizeof r->error, "cannot write the download: %s", strerror(errno));
 		else if (t->body.overflow)
 			snprintf(r->error, sizeof r->error, "answer larger than %ld bytes", (long)HTTP_MAX_BODY);
+		else if ((r->tls_unverified = rc == CURLE_PEER_FAILED_VERIFICATION || rc == CURLE_SSL_CACERT_BADFILE))
+			snprintf(r->error, sizeof r->error, "cannot verify the server's TLS certificate against %s%.200s%s: %.200s",
+				 ca_file_path[0] ? "the CA file '" : "the system's certificate authorities",
+				 ca_file_path, ca_file_path[0] ? "'" : "", curl_error[0] ? curl_error : curl_easy_strerror(rc));
 		else
 			snprintf(r->error, sizeof r->error, "%s", curl_error[0] ? curl_error : curl_easy_strerror(rc));
 		r->local = t->write_failed;

@@ -38,6 +38,8 @@ struct http_response {
 	int local;                    /* 1 when the call failed on this side (a file that cannot be
 				       * opened, created or written, no memory): status 0, yet not for
 				       * want of an answer */
+	int tls_unverified;           /* 1 when the server's TLS certificate failed verification: a
+				       * setting to fix (the CA file), not a failure to retry */
 };
 
 /* Called once per line of a streamed answer, without the newline; a last line without a newline
@@ -47,6 +49,11 @@ typedef int (*http_line_fn)(const char *line, size_t len, void *user);
 /* Once per process before threads start; 0, or -1 when libcurl cannot initialise. */
 int http_global_init(void);
 void http_global_cleanup(void);
+
+/* Once per process before threads start: https servers' certificates are verified against the
+ * certificate authorities in the PEM file ca_file (copied), or the system's when NULL or "".
+ * Verification is never switched off; a failed one is an error naming the file. */
+void http_global_ca_file(const char *ca_file);
 
 /* A client for server (base URL, e.g. "http://127.0.0.1:8080", a trailing slash is ignored) with
  * token (may be NULL or "" for /healthz). NULL when out of memory. */
@@ -87,7 +94,8 @@ void http_response_release(struct http_response *r);
 /* 1 when the status is 2xx. */
 int http_ok(const struct http_response *r);
 
-/* 1 when repeating the same request may succeed: no answer, 5xx, 408 or 429. */
+/* 1 when repeating the same request may succeed: no answer (but for a TLS certificate that failed
+ * verification), 5xx, 408 or 429. */
 int http_transient(const struct http_response *r);
 
 /* A one-line description of a failed call for messages: "message (code, field /x)" for server

@@ -41,6 +41,23 @@ struct stored_file {
 /* Answers with the stored file, checked against its index row on the way (files_serve.c): its
  * size always, its SHA-256 for whole-file downloads; a damaged copy is 500 stored_file_damaged. */
 void files_serve(struct request *r, const struct stored_file *f, const char *content_type);
+/* Answers with the newest attempt's version of a JSON file a worker derived from result.h5
+ * (probes.json, frames.json) of the job {id}, as files_serve; 404 naming what (e.g. "probes")
+ * while no attempt has uploaded it. */
+void files_serve_newest(struct request *r, const char *name, const char *what);
+
+/* the dashboard (docs/web.md): static files (web.c), validation without a job (jobs_api.c), a
+ * job's case and the admin view (web_api.c), the field viewer's frames (frames.c) */
+void web_index(struct request *r);
+void web_file(struct request *r);
+/* WEB_ROOT when --web-root is not given: BINDIR/../share/poro/web or BINDIR/../web, the first
+ * holding index.html, into out; "" when neither does. */
+void web_root_default(char *out, size_t size);
+void jobs_validate(struct request *r);
+void web_job_case(struct request *r);
+void web_admin_workers(struct request *r);
+void frames_index(struct request *r);
+void frames_get(struct request *r);
 
 /* operators */
 void admin_healthz(struct request *r);

@@ -9,8 +9,10 @@
  * write, only if the attempt still holds the lease (store_file_commit). A file without an index
  * row is never served. Names are checked before anything touches the disk (api_file_name).
  *
- * probes.json is the one file whose content the server checks: it is served as the answer of GET
- * /v1/jobs/{id}/probes, so it must be one JSON object. json_scan checks it while it streams in, in
+ * probes.json, frames.json and metrics.json are the files whose content the server checks:
+ * probes.json and frames.json are served as the answers of GET /v1/jobs/{id}/probes and
+ * GET /v1/jobs/{id}/frames (frames.c reads the latter's ranges), metrics.json is read by benchmark
+ * runs (bench_metrics.c), so each must be one JSON object. json_scan checks it while it streams in, in
  * constant memory, within JSON_FILE_MAX_BYTES (or --max-upload-bytes when smaller), a nesting depth
  * and a token length; a file that fails is 422 invalid_json_file naming the line and column, and
  * is not stored. The server never parses result files (docs/service.md §3, "Probes").
@@ -35,7 +37,8 @@
 
 #define ATTEMPT_MAX 1000000
 #define NAME_SIZE 129
-#define JSON_FILE_NAME "probes.json"
+/* the files checked as JSON objects while they stream in */
+static const char *const JSON_FILE_NAMES[] = { "probes.json", "frames.json", "metrics.json", NULL };
 #define JSON_FILE_MAX_BYTES (256LL << 20) /* bytes: 3 probes of 2 million steps (120 bytes a step) */
 #define JSON_FILE_DEPTH_MAX 16            /* the probes document nests 4 deep */
 #define JSON_FILE_TOKEN_MAX 4096          /* bytes of one string or number */
@@ -72,7 +75,10 @@ static int checksum_header(struct request *r, char out[DIGEST_HEX_SIZE])
 /* A file the server serves as JSON is checked as it arrives: 0, or -1 after replying 413. */
 static int json_file_begin(struct request *r, struct upload *u)
 {
-	if (strcmp(u->name, JSON_FILE_NAME) != 0)
+	int json = 0;
+	for (const char *const *n = JSON_FILE_NAMES; *n && !json; n++)
+		json = strcmp(u->name, *n) == 0;
+	if (!json)
 		return 0;
 	u->json = 1;
 	u->limit = JSON_FILE_MAX_BYTES < r->srv->cfg.max_upload_bytes ? JSON_FILE_MAX_BYTES : r->srv->cfg.max_upload_bytes;
@@ -138,16 +144,24 @@ void files_upload_begin(struct request *r)
 	}
 	char dir[SERVER_PATH_MAX], token[DIGEST_TOKEN_SIZE];
 	snprintf(dir, sizeof dir, "%s/files/%lld/%d", r->srv->cfg.state, r->id, u->attempt);
-	if (fs_make_dirs(dir) != 0 || digest_new_token(token) != 0) {
-		reply_fail(r, API_INTERNAL, "", "cannot create '%s': %s", dir, strerror(errno));
+	/* files/JOB and files/JOB/ATTEMPT must be durable before an index row names a file in them
+	 * (tests/fault/power_loss_test.sh lost every upload of a power cut without this) */
+	if (fs_make_dirs(dir) != 0 || fs_sync_parents(dir, 2) != 0) {
+		reply_fail(r, api_storage_code(errno), "", "cannot create the directory of '%s': %s", u->name, strerror(errno));
+		return;
+	}
+	if (digest_new_token(token) != 0) {
+		reply_fail(r, API_INTERNAL, "", "no randomness for a temporary name of '%s'", u->name);
 		return;
 	}
 	snprintf(u->tmp, sizeof u->tmp, "%s/.tmp-%s-%.16s", dir, u->name, token + 5);
 	snprintf(u->final, sizeof u->final, "%s/%s", dir, u->name);
 	u->fd = open(u->tmp, O_WRONLY | O_CREAT | O_EXCL, 0644);
 	u->digest = digest_create();
-	if (u->fd < 0 || !u->digest)
-		reply_fail(r, API_INTERNAL, "", "cannot create '%s': %s", u->tmp, strerror(errno));
+	if (u->fd < 0)
+		reply_fail(r, api_storage_code(errno), "", "cannot create a file for '%s': %s", u->name, strerror(errno));
+	else if (!u->digest)
+		reply_fail(r, API_UNAVAILABLE, "", "no memory to receive '%s'", u->name);
 }
 
 int files_upload_data(struct request *r, const char *data, size_t size)
@@ -162,7 +176,8 @@ int files_upload_data(struct request *r, const char *data, size_t size)
 		if (n < 0 && errno == EINTR)
 			continue;
 		if (n <= 0) {
-			reply_fail(r, API_INTERNAL, "", "cannot write '%s': %s", u->name, strerror(errno));
+			reply_fail(r, api_storage_code(n < 0 ? errno : ENOSPC), "", "cannot write '%s': %s", u->name,
+				   strerror(n < 0 ? errno : ENOSPC));
 			return -1;
 		}
 		data += n;
@@ -187,10 +202,11 @@ void files_upload_end(struct request *r)
 		return;
 	}
 	int synced = fsync(u->fd) == 0;
+	int e = errno;
 	close(u->fd);
 	u->fd = -1;
 	if (!synced) {
-		reply_fail(r, API_INTERNAL, "", "cannot sync '%s': %s", u->name, strerror(errno));
+		reply_fail(r, api_storage_code(e), "", "cannot sync '%s': %s", u->name, strerror(e));
 		return;
 	}
 	struct api_error err = { 0 };

@@ -27,6 +27,7 @@
  */
 #include "api.h"
 #include "log.h"
+#include "store.h"
 
 #include "digest.h"
 
@@ -313,4 +314,23 @@ void files_serve(struct request *r, const struct stored_file *f, const char *con
 	r->reply.content_type = content_type;
 	reply_header(r, "Accept-Ranges", "bytes");
 	reply_header(r, "X-Checksum-Sha256", f->sha256);
+}
+
+void files_serve_newest(struct request *r, const char *name, const char *what)
+{
+	if (api_job_visible(r))
+		return;
+	int attempt;
+	long long size;
+	char sha[DIGEST_HEX_SIZE];
+	struct api_error err = { 0 };
+	if (store_file_find(r->srv->store, r->id, name, -1, &attempt, &size, sha, &err) != API_OK) {
+		if (err.code != API_NOT_FOUND) {
+			reply_error(r, &err);
+			return;
+		}
+		reply_fail(r, API_NOT_FOUND, "", "job %lld has no %s yet: no attempt has uploaded %s", r->id, what, name);
+		return;
+	}
+	files_serve(r, &(struct stored_file){ r->id, attempt, name, size, sha }, "application/json");
 }

@@ -18,6 +18,7 @@
  */
 #define _GNU_SOURCE /* accept4, POLLRDHUP */
 #include "front_door.h"
+#include "listen_socket.h"
 
 #include "log.h"
 #include "metrics.h"
@@ -456,60 +457,13 @@ static void *door_main(void *arg)
 
 /* ---- start and stop ---- */
 
-static int split_listen(const char *listen, char *host, size_t host_size, char *port, size_t port_size)
-{
-	const char *colon = strrchr(listen, ':');
-	if (!colon || !colon[1])
-		return -1;
-	const char *h = listen;
-	size_t n = (size_t)(colon - listen);
-	if (n >= 2 && h[0] == '[' && h[n - 1] == ']') {
-		h++;
-		n -= 2;
-	}
-	if (n == 0 || n >= host_size || strlen(colon + 1) >= port_size)
-		return -1;
-	memcpy(host, h, n);
-	host[n] = '\0';
-	snprintf(port, port_size, "%s", colon + 1);
-	return 0;
-}
-
 static int open_listener(struct front_door *d, char *url, size_t url_size, char *msg, size_t msg_size)
 {
-	const char *listen_at = d->srv->cfg.listen;
-	char host[256], port[16];
-	if (split_listen(listen_at, host, sizeof host, port, sizeof port) != 0) {
-		snprintf(msg, msg_size, "invalid --listen '%s': expected HOST:PORT", listen_at);
+	const struct server_config *cfg = &d->srv->cfg;
+	int fd = listen_socket_open(cfg->listen, "--listen", "http", !cfg->allow_plain_http, LISTEN_BACKLOG, url,
+				    url_size, msg, msg_size);
+	if (fd < 0)
 		return -1;
-	}
-	struct addrinfo hints = { .ai_family = AF_UNSPEC, .ai_socktype = SOCK_STREAM, .ai_flags = AI_PASSIVE };
-	struct addrinfo *ai = NULL;
-	int gai = getaddrinfo(host, port, &hints, &ai);
-	if (gai != 0) {
-		snprintf(msg, msg_size, "cannot resolve --listen '%s': %s", listen_at, gai_strerror(gai));
-		return -1;
-	}
-	int fd = socket(ai->ai_family, SOCK_STREAM | SOCK_NONBLOCK | SOCK_CLOEXEC, 0);
-	int one = 1;
-	if (fd >= 0)
-		setsockopt(fd, SOL_SOCKET, SO_REUSEADDR, &one, sizeof one);
-	if (fd < 0 || bind(fd, ai->ai_addr, ai->ai_addrlen) != 0 || listen(fd, LISTEN_BACKLOG) != 0) {
-		snprintf(msg, msg_size, "cannot listen on '%s': %s", listen_at, strerror(errno));
-		if (fd >= 0)
-			close(fd);
-		freeaddrinfo(ai);
-		return -1;
-	}
-	freeaddrinfo(ai);
-	struct sockaddr_storage bound;
-	socklen_t len = sizeof bound;
-	int actual = 0;
-	if (getsockname(fd, (struct sockaddr *)&bound, &len) == 0)
-		actual = ntohs(bound.ss_family == AF_INET6 ? ((struct sockaddr_in6 *)&bound)->sin6_port
-							   : ((struct sockaddr_in *)&bound)->sin_port);
-	int v6 = strchr(host, ':') != NULL;
-	snprintf(url, url_size, "http://%s%s%s:%d", v6 ? "[" : "", host, v6 ? "]" : "", actual);
 	d->listen_fd = fd;
 	return 0;
 }

@@ -25,12 +25,15 @@
  * transactions, so a failed one leaves nothing half done.
  */
 #include "api.h"
+#include "bench.h"
 #include "front_door.h"
 #include "http.h"
+#include "listen_socket.h"
 #include "log.h"
 #include "metrics.h"
 #include "request_gate.h"
 #include "store.h"
+#include "tls_files.h"
 
 #include "digest.h"
 #include "json_scan.h"
@@ -55,6 +58,7 @@
 					   * REQUEST_HEAD_MAX with room to spare */
 #define THREAD_STACK_BYTES (2u << 20)     /* per connection thread; enough for the deepest handler */
 #define STREAM_BLOCK 16384
+#define TLS_LISTEN_BACKLOG 1024           /* the kernel's queue of the HTTPS listener */
 #define TRIM_AFTER_BYTES (1 << 20)        /* a JSON body this large: return freed memory to the system */
 
 /* The body limits of each kind of route (enum body_kind); --max-body-bytes caps the JSON ones. */
@@ -87,6 +91,20 @@ static const struct route ROUTES[] = {
 	{ "POST", "/v1/tokens", ROLE_ADMIN, BODY_SMALL, admin_tokens_create, 0, 0, 0, 0 },
 	{ "GET", "/v1/tokens", USER_ROLES, BODY_SMALL, admin_tokens_list, 0, 0, 0, 0 },
 	{ "DELETE", "/v1/tokens/{id}", USER_ROLES, BODY_SMALL, admin_tokens_revoke, 0, 0, 0, 0 },
+	/* the dashboard (docs/web.md): its static files, and what its pages read */
+	{ "GET", "/", 0, BODY_SMALL, web_index, 0, 0, 0, 0 },
+	{ "GET", "/web/{name}", 0, BODY_SMALL, web_file, 0, 0, 0, 0 },
+	{ "POST", "/v1/cases/validate", USER_ROLES, BODY_CASE, jobs_validate, 0, 0, 0, 0 },
+	{ "GET", "/v1/jobs/{id}/case", USER_ROLES, BODY_SMALL, web_job_case, 0, 0, 0, 0 },
+	{ "GET", "/v1/jobs/{id}/frames", USER_ROLES, BODY_SMALL, frames_index, 0, 0, 0, 0 },
+	{ "GET", "/v1/jobs/{id}/frames/{frame}", USER_ROLES, BODY_SMALL, frames_get, 0, 0, 0, 0 },
+	{ "GET", "/v1/admin/workers", ROLE_ADMIN, BODY_SMALL, web_admin_workers, 0, 0, 0, 0 },
+	/* benchmark runs (bench.h): a plan names up to 500 cases, so it may be larger than a small body */
+	{ "POST", "/v1/benchmarks", USER_ROLES, BODY_CASE, bench_create, 0, 0, 0, 0 },
+	{ "GET", "/v1/benchmarks", USER_ROLES, BODY_SMALL, bench_list, 0, 0, 0, 0 },
+	{ "GET", "/v1/benchmarks/series", USER_ROLES, BODY_SMALL, bench_series, 0, 0, 0, 0 },
+	{ "GET", "/v1/benchmarks/{id}", USER_ROLES, BODY_SMALL, bench_show, 0, 0, 0, 0 },
+	{ "POST", "/v1/benchmarks/{id}/finish", USER_ROLES, BODY_SMALL, bench_finish, 0, 0, 0, 0 },
 };
 #define ROUTE_COUNT (sizeof ROUTES / sizeof ROUTES[0])
 
@@ -96,6 +114,9 @@ struct http {
 	struct MHD_Daemon *daemon;
 	struct front_door *door;
 	struct request_gate *gate;
+	struct MHD_Daemon *tls_daemon;  /* --tls-listen, or NULL */
+	char *tls_cert, *tls_key;       /* PEM texts, kept while tls_daemon runs */
+	char tls_url[300];              /* "https://HOST:PORT", "" without --tls-listen */
 };
 
 /* Per-request state beyond struct request. */
@@ -243,6 +264,14 @@ void reply_header(struct request *r, const char *name, const char *value)
 	rep->header_count++;
 }
 
+static int reply_has_header(struct request *r, const char *name)
+{
+	for (int i = 0; i < r->reply.header_count; i++)
+		if (strcasecmp(r->reply.headers[i][0], name) == 0)
+			return 1;
+	return 0;
+}
+
 void reply_text(struct request *r, int status, const char *content_type, char *owned_text, size_t size)
 {
 	free(r->reply.body);
@@ -278,7 +307,11 @@ void reply_error(struct request *r, struct api_error *err)
 	if (err->code == API_LOG_GAP)
 		json_object_set_new(e, "expected_offset", json_integer(err->expected_offset));
 	reply_header(r, "Cache-Control", "no-store");
-	reply_json(r, api_code_status(err->code), json_pack("{s:o}", "error", e));
+	/* the server's passing states (no memory, a failing or full disk) say when to try again */
+	int status = api_code_status(err->code);
+	if ((status == 503 || status == 507) && !reply_has_header(r, "Retry-After"))
+		reply_header(r, "Retry-After", status == 507 ? "10" : "1");
+	reply_json(r, status, json_pack("{s:o}", "error", e));
 }
 
 enum api_code reply_fail(struct request *r, enum api_code code, const char *field, const char *fmt, ...)
@@ -422,12 +455,24 @@ static int match(const char *pattern, const char *path, long long *id, char **na
 			*id = v;
 			u += seg;
 			p += 4;
+		} else if (strncmp(p, "{frame}", 7) == 0) { /* a frame's number: 0 or more, one element */
+			if (seg == 0 || seg > 9 || (u[0] == '0' && seg > 1) || strspn(u, "0123456789") < seg)
+				return 0;
+			*name = strndup(u, seg);
+			if (!*name)
+				return 0;
+			u += seg;
+			p += 7;
 		} else { /* {name}: the rest of the path */
 			*name = strdup(u);
 			return *name != NULL;
 		}
 	}
-	return *u == '\0';
+	if (*u == '\0')
+		return 1;
+	free(*name); /* a {frame} matched, and the path goes on */
+	*name = NULL;
+	return 0;
 }
 
 /* Finds the route; 0, or an error code after replying (404, 405). */
@@ -741,6 +786,46 @@ static int admit(void *cls, int fd, const struct sockaddr *addr, socklen_t addr_
 	return MHD_add_connection(h->daemon, fd, addr, addr_len) == MHD_YES ? 0 : -1;
 }
 
+/* The HTTPS listener of --tls-listen (docs/operations.md, "TLS"): libmicrohttpd with GnuTLS, on a
+ * socket of its own. The front door cannot read an encrypted head, so these connections skip it:
+ * libmicrohttpd's own limits stand in (connections in all, per client address, a silent
+ * connection's timeout), and the per-token limits and body checks of this file apply as on the
+ * plain listener. 0 (nothing to do without --tls-listen), or -1 with msg set. */
+static int start_tls(struct http *h, char *msg, size_t msg_size)
+{
+	const struct server_config *cfg = &h->srv->cfg;
+	if (tls_files_load(cfg, &h->tls_cert, &h->tls_key, msg, msg_size) != 0)
+		return -1;
+	if (!h->tls_cert)
+		return 0;
+	int fd = listen_socket_open(cfg->tls_listen, "--tls-listen", "https", 0, TLS_LISTEN_BACKLOG, h->tls_url,
+				    sizeof h->tls_url, msg, msg_size);
+	if (fd < 0)
+		return -1;
+	unsigned flags = MHD_USE_THREAD_PER_CONNECTION | MHD_USE_INTERNAL_POLLING_THREAD | MHD_USE_POLL |
+			 MHD_USE_ITC | MHD_USE_ERROR_LOG | MHD_USE_TLS;
+	h->tls_daemon = MHD_start_daemon(
+		flags, 0, NULL, NULL, on_request, h, MHD_OPTION_EXTERNAL_LOGGER, engine_log, NULL,
+		MHD_OPTION_LISTEN_SOCKET, fd, MHD_OPTION_HTTPS_MEM_CERT, h->tls_cert, MHD_OPTION_HTTPS_MEM_KEY,
+		h->tls_key, MHD_OPTION_CONNECTION_LIMIT, (unsigned)(cfg->max_connections + cfg->max_worker_connections),
+		MHD_OPTION_PER_IP_CONNECTION_LIMIT, (unsigned)cfg->max_connections_per_client,
+		MHD_OPTION_NOTIFY_COMPLETED, on_completed, h, MHD_OPTION_UNESCAPE_CALLBACK, no_unescape, NULL,
+		MHD_OPTION_CONNECTION_TIMEOUT, (unsigned)CONNECTION_TIMEOUT_SECONDS, MHD_OPTION_CONNECTION_MEMORY_LIMIT,
+		(size_t)CONNECTION_MEMORY, MHD_OPTION_THREAD_STACK_SIZE, (size_t)THREAD_STACK_BYTES, MHD_OPTION_END);
+	if (!h->tls_daemon) {
+		close(fd);
+		snprintf(msg, msg_size, "cannot serve TLS on --tls-listen '%s' with --tls-cert '%s' and --tls-key '%s' "
+			 "(the log says why)", cfg->tls_listen, cfg->tls_cert, cfg->tls_key);
+		return -1;
+	}
+	return 0;
+}
+
+const char *http_tls_url(void *http)
+{
+	return ((struct http *)http)->tls_url;
+}
+
 void *http_start(struct server *srv, char *url, size_t url_size, char *msg, size_t msg_size)
 {
 	struct http *h = calloc(1, sizeof *h);
@@ -774,7 +859,7 @@ void *http_start(struct server *srv, char *url, size_t url_size, char *msg, size
 		return NULL;
 	}
 	h->door = front_door_start(srv, admit, h, url, url_size, msg, msg_size);
-	if (!h->door) {
+	if (!h->door || start_tls(h, msg, msg_size) != 0) {
 		http_stop(h);
 		return NULL;
 	}
@@ -785,6 +870,11 @@ void http_quiesce(void *http)
 {
 	struct http *h = http;
 	front_door_quiesce(h->door);
+	if (h->tls_daemon) {
+		MHD_socket fd = MHD_quiesce_daemon(h->tls_daemon);
+		if (fd != MHD_INVALID_SOCKET)
+			close(fd);
+	}
 }
 
 void http_stop(void *http)
@@ -793,8 +883,12 @@ void http_stop(void *http)
 	if (!h)
 		return;
 	front_door_quiesce(h->door);
+	if (h->tls_daemon)
+		MHD_stop_daemon(h->tls_daemon);
 	if (h->daemon)
 		MHD_stop_daemon(h->daemon);
+	free(h->tls_cert);
+	free(h->tls_key);
 	front_door_destroy(&h->door);
 	request_gate_destroy(&h->gate);
 	free(h);

@@ -126,6 +126,8 @@ struct route {
 void *http_start(struct server *srv, char *url, size_t url_size, char *msg, size_t msg_size);
 /* Stops accepting new connections (in-flight requests go on). */
 void http_quiesce(void *http);
+/* "https://HOST:PORT" of --tls-listen (port as bound), or "" without it. */
+const char *http_tls_url(void *http);
 /* Waits for every connection thread and stops; frees what http_start made. */
 void http_stop(void *http);
 

@@ -15,21 +15,24 @@
  * job, as "warnings" [{"field", "message"}] beside the 201 or 200, so that a user who submits over
  * HTTP learns what `poro-solve validate` would have printed; they are not stored.
  */
+#define _DEFAULT_SOURCE /* timegm */
 #include "api.h"
 #include "store.h"
 
 #include "case.h"
 #include "digest.h"
+#include "jobs_submit.h"
 
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
 
 #define PRIORITY_MIN -100
 #define PRIORITY_MAX 100
 #define THREADS_MAX 256
 #define WALL_TIME_MAX 2592000LL           /* s, 30 days */
-#define WALL_TIME_DEFAULT 86400           /* s */
+#define WALL_TIME_DEFAULT JOB_WALL_TIME_DEFAULT /* s, server.h */
 #define IDEMPOTENCY_KEY_MAX 200
 #define LIST_LIMIT_MAX 1000
 #define LIST_LIMIT_DEFAULT 100
@@ -78,7 +81,7 @@ static int check_case(struct request *r, const json_t *case_spec, struct case_sp
 		reply_fail(r, API_UNAVAILABLE, "", "no memory to check the case: retry later");
 		return -1;
 	}
-	enum poro_status st = case_load_json(case_spec, loaded, perr);
+	enum poro_status st = jobs_case_load(case_spec, loaded, perr);   /* by the loader its schema names */
 	if (st == PORO_OK) {
 		free(perr);
 		return 0;
@@ -141,8 +144,11 @@ static int idempotency_key(struct request *r, const char **key)
 struct submission {
 	char *canonical;                 /* the case in canonical form, owned */
 	char *name;                      /* owned, or NULL */
+	char *title;                     /* the case's title, owned, or NULL */
 	json_t *warnings;                /* the case's warnings as [{field, message}], owned */
 	const char *key;                 /* the Idempotency-Key header, or NULL */
+	char *batch;                     /* owned, or NULL (jobs_batch.c) */
+	int exclusive;
 	long long priority, threads, wall;
 	char case_sha[DIGEST_HEX_SIZE], body_sha[DIGEST_HEX_SIZE];
 };
@@ -151,6 +157,8 @@ static void submission_release(struct submission *s)
 {
 	free(s->canonical);
 	free(s->name);
+	free(s->title);
+	free(s->batch);
 	json_decref(s->warnings);
 }
 
@@ -159,7 +167,8 @@ static void submission_release(struct submission *s)
  * replying. */
 static int submission_check(struct request *r, struct submission *s)
 {
-	static const char *const keys[] = { "case", "priority", "threads", "wall_time_seconds", "name", NULL };
+	static const char *const keys[] = { "case", "priority", "threads", "wall_time_seconds", "name", "batch",
+					    "exclusive", NULL };
 	json_t *body = api_body_object(r);
 	if (!body)
 		return -1;
@@ -177,12 +186,14 @@ static int submission_check(struct request *r, struct submission *s)
 	if (api_int_member(r, body, "priority", PRIORITY_MIN, PRIORITY_MAX, 0, &s->priority) ||
 	    api_int_member(r, body, "threads", 1, THREADS_MAX, 1, &s->threads) || check_threads(r, s->threads) ||
 	    api_int_member(r, body, "wall_time_seconds", 1, WALL_TIME_MAX, WALL_TIME_DEFAULT, &s->wall) ||
-	    api_string_member(r, body, "name", SERVER_NAME_MAX, 0, &name) || check_case(r, case_spec, &loaded))
+	    api_string_member(r, body, "name", SERVER_NAME_MAX, 0, &name) ||
+	    jobs_batch_members(r, body, &s->batch, &s->exclusive) || check_case(r, case_spec, &loaded))
 		goto done;
 	whole = json_dumps(body, JSON_COMPACT | JSON_SORT_KEYS);
 	s->name = name ? strdup(name) : NULL;
 	s->warnings = case_problems(loaded->warnings);
-	if (!whole || (name && !s->name) || !s->warnings) {
+	s->title = loaded->title[0] ? strdup(loaded->title) : NULL;
+	if (!whole || (name && !s->name) || !s->warnings || (loaded->title[0] && !s->title)) {
 		reply_fail(r, API_UNAVAILABLE, "", "no memory to store the case: retry later");
 		goto done;
 	}
@@ -216,9 +227,9 @@ void jobs_submit(struct request *r)
 		return;
 	}
 	struct job_submit in = { .who = &r->who, .idempotency_key = s.key, .body_sha256 = s.body_sha,
-				 .case_json = s.canonical, .case_sha256 = s.case_sha, .name = s.name,
+				 .case_json = s.canonical, .case_sha256 = s.case_sha, .name = s.name, .case_title = s.title,
 				 .priority = (int)s.priority, .threads = (int)s.threads,
-				 .wall_time_seconds = (int)s.wall };
+				 .wall_time_seconds = (int)s.wall, .batch = s.batch, .exclusive = s.exclusive };
 	json_t *job = NULL;
 	int created = 0;
 	struct api_error err = { 0 };
@@ -232,6 +243,23 @@ void jobs_submit(struct request *r)
 		json_object_set_new(job, "warnings", s.warnings);   /* the answer's, not stored */
 		s.warnings = NULL;
 		reply_json(r, created ? 201 : 200, job);
+	}
+	submission_release(&s);
+}
+
+/* POST /v1/cases/validate: the checks of a submission, nothing stored (docs/web.md, "Submit"). The
+ * body is what POST /v1/jobs takes, so its problems name the same fields (/case/...); a valid one
+ * answers 200 with the case's title, the SHA-256 its job would get and the case's warnings. */
+void jobs_validate(struct request *r)
+{
+	struct submission s = { 0 };
+	if (http_submission_enter(r) != 0)
+		return;
+	int checked = submission_check(r, &s) == 0;
+	http_submission_leave(r);
+	if (checked) {
+		reply_json(r, 200, json_pack("{s:b, s:s, s:o, s:O}", "valid", 1, "case_sha256", s.case_sha, "title",
+					     s.title ? json_string(s.title) : json_null(), "warnings", s.warnings));
 	}
 	submission_release(&s);
 }
@@ -261,16 +289,100 @@ static int parse_states(struct request *r, unsigned *mask)
 	return 0;
 }
 
+/* A text filter of the search: 1 when given (into out), 0 when absent or empty, -1 after replying. */
+static int search_text(struct request *r, const char *name, char *out, size_t size)
+{
+	int have = http_query(r, name, out, size);
+	if (have < 0) {
+		reply_fail(r, API_INVALID_PARAMETER, name, "query parameter '%s' is too long or badly encoded", name);
+		return -1;
+	}
+	return have && out[0];
+}
+
+/* A time of the search, RFC 3339 ("2026-12-07T10:30:00Z", seconds and fraction optional) or a
+ * date ("2026-12-07": its start, or with end_of_day its last millisecond), UTC: ms into *ms (0
+ * when absent), or -1 after replying 400. */
+static int search_time(struct request *r, const char *name, int end_of_day, long long *ms)
+{
+	char text[64];
+	*ms = 0;
+	int have = http_query(r, name, text, sizeof text);
+	if (have == 0 || (have > 0 && !text[0]))
+		return 0;
+	struct tm tm = { 0 };
+	int frac = 0, n = 0, used = 0;
+	double seconds = 0;
+	int ok = have > 0 && sscanf(text, "%4d-%2d-%2d%n", &tm.tm_year, &tm.tm_mon, &tm.tm_mday, &n) == 3 && n == 10;
+	if (ok && text[10]) {
+		ok = (text[10] == 'T' || text[10] == ' ') &&
+		     sscanf(text + 11, "%2d:%2d%n", &tm.tm_hour, &tm.tm_min, &used) == 2;
+		const char *rest = text + 11 + used;
+		if (ok && *rest == ':') {
+			ok = sscanf(rest + 1, "%lf%n", &seconds, &frac) == 1 && seconds >= 0 && seconds < 61;
+			rest += 1 + frac;
+		}
+		ok = ok && (!strcmp(rest, "Z") || !*rest);
+	}
+	tm.tm_year -= 1900;
+	tm.tm_mon -= 1;
+	ok = ok && tm.tm_mon >= 0 && tm.tm_mon < 12 && tm.tm_mday >= 1 && tm.tm_mday <= 31 && tm.tm_hour < 24 &&
+	     tm.tm_min < 60 && tm.tm_year >= 70;
+	if (!ok) {
+		reply_fail(r, API_INVALID_PARAMETER, name,
+			   "query parameter '%s' must be a UTC date (2026-12-07) or time (2026-12-07T10:30:00Z)", name);
+		return -1;
+	}
+	*ms = (long long)timegm(&tm) * 1000 + (long long)(seconds * 1000);
+	if (end_of_day && !text[10])
+		*ms += 86400000LL - 1;
+	return 0;
+}
+
+/* The dashboard's filters (docs/web.md, "Jobs"): 1 with q filled when any is given, 0 when none
+ * is (the plain listing), -1 after replying 400. */
+static int search_query(struct request *r, struct job_search *q, char user[SERVER_NAME_MAX + 1],
+			char name[SERVER_NAME_MAX + 1], char title[SERVER_NAME_MAX * 2])
+{
+	char order[16];
+	int have_order = http_query(r, "order", order, sizeof order);
+	if (have_order < 0 || (have_order > 0 && strcmp(order, "newest") && strcmp(order, "oldest"))) {
+		reply_fail(r, API_INVALID_PARAMETER, "order", "query parameter 'order' must be newest or oldest");
+		return -1;
+	}
+	int u = search_text(r, "user", user, SERVER_NAME_MAX + 1);
+	int n = u < 0 ? -1 : search_text(r, "name", name, SERVER_NAME_MAX + 1);
+	int t = n < 0 ? -1 : search_text(r, "title", title, SERVER_NAME_MAX * 2);
+	if (t < 0 || search_time(r, "created_after", 0, &q->created_from) ||
+	    search_time(r, "created_before", 1, &q->created_to))
+		return -1;
+	q->user = u ? user : NULL;
+	q->name = n ? name : NULL;
+	q->title = t ? title : NULL;
+	q->oldest_first = have_order > 0 && !strcmp(order, "oldest");
+	return u || n || t || q->created_from || q->created_to || q->oldest_first;
+}
+
 void jobs_list(struct request *r)
 {
 	unsigned states;
 	long long limit, after;
+	struct job_search q = { 0 };
+	char user[SERVER_NAME_MAX + 1], name[SERVER_NAME_MAX + 1], title[SERVER_NAME_MAX * 2];
 	if (parse_states(r, &states) || api_query_int(r, "limit", 1, LIST_LIMIT_MAX, LIST_LIMIT_DEFAULT, &limit) ||
 	    api_query_int(r, "after", 1, ID_MAX, 0, &after))
 		return;
+	int search = search_query(r, &q, user, name, title);
+	if (search < 0)
+		return;
 	json_t *page = NULL;
 	struct api_error err = { 0 };
-	if (store_job_list(r->srv->store, &r->who, states, (int)limit, after, &page, &err) != API_OK) {
+	q.states = states;
+	q.limit = (int)limit;
+	q.after = after;
+	enum api_code rc = search ? store_job_search(r->srv->store, &r->who, &q, &page, &err)
+				  : store_job_list(r->srv->store, &r->who, states, (int)limit, after, &page, &err);
+	if (rc != API_OK) {
 		reply_error(r, &err);
 		return;
 	}
@@ -313,19 +425,5 @@ void jobs_cancel(struct request *r)
  * file. A job without probes.json yet is 404 saying so. */
 void jobs_probes(struct request *r)
 {
-	if (api_job_visible(r))
-		return;
-	int attempt;
-	long long size;
-	char sha[DIGEST_HEX_SIZE];
-	struct api_error err = { 0 };
-	if (store_file_find(r->srv->store, r->id, "probes.json", -1, &attempt, &size, sha, &err) != API_OK) {
-		if (err.code != API_NOT_FOUND) {
-			reply_error(r, &err);
-			return;
-		}
-		reply_fail(r, API_NOT_FOUND, "", "job %lld has no probes yet: no attempt has uploaded probes.json", r->id);
-		return;
-	}
-	files_serve(r, &(struct stored_file){ r->id, attempt, "probes.json", size, sha }, "application/json");
+	files_serve_newest(r, "probes.json", "probes");
 }

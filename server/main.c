@@ -15,6 +15,8 @@
  * command line is read by getopt_long (--opt=value or --opt value, abbreviations, "--"); --help
  * and --version print on stdout and exit 0, a bad command line or config file exits 2.
  */
+#include "api.h"
+#include "backup_cli.h"
 #include "file_sweep.h"
 #include "http.h"
 #include "log.h"
@@ -83,7 +85,12 @@ static const struct option_def OPTIONS[] = {
 	TEXT_OPT("access-log", "FILE", access_log, "append the log's request lines (logfmt) to FILE too (default none)"),
 	LONG_OPT("max-log-bytes", max_log_bytes, 65536, 1LL << 50, "log text kept per attempt: its first and last half (default 67108864)"),
 	LONG_OPT("user-max-stored-bytes", user_max_stored_bytes, 0, 1LL << 60, "default per-user cap on stored bytes (cases, logs, files), 0 = unlimited (default 2147483648)"),
+	TEXT_OPT("tls-listen", "HOST:PORT", tls_listen, "also serve HTTPS on HOST:PORT, for workers and users on other hosts (default none)"),
+	TEXT_OPT("tls-cert", "FILE", tls_cert, "PEM certificate (chain) of --tls-listen"),
+	TEXT_OPT("tls-key", "FILE", tls_key, "PEM private key of --tls-listen"),
+	INT_OPT("allow-plain-http", allow_plain_http, 0, 1, "1: let --listen be an address other than loopback, tokens in clear text (default 0)"),
 	INT_OPT("min-free-mb", min_free_mb, 0, 1 << 30, "/healthz is degraded below this free space on the state file system, MiB (default 64)"),
+	TEXT_OPT("web-root", "DIR", web_root, "the dashboard's files (default BINDIR/../share/poro/web, else BINDIR/../web)"),
 };
 #define OPTION_COUNT (sizeof OPTIONS / sizeof OPTIONS[0])
 
@@ -104,7 +111,9 @@ static void usage(void)
 	printf("usage: poro-server [--config=FILE] [--OPTION=VALUE ...]\n"
 	       "       poro-server token create --state=DIR --user=NAME --role=user|worker|admin [--label=TEXT]\n"
 	       "       poro-server token list --state=DIR\n"
-	       "       poro-server token revoke --state=DIR --id=N\n\n"
+	       "       poro-server token revoke --state=DIR --id=N\n"
+	       "       poro-server backup --state=DIR --out=FILE     (online: the server may run)\n"
+	       "       poro-server restore --state=DIR --from=FILE   (with the server stopped)\n\n"
 	       "The HTTP job server of PoroMPM (docs/service.md). Every option may also be a line\n"
 	       "'name = value' in the config file; options on the command line win over the file.\n"
 	       "--opt=VALUE and --opt VALUE are the same.\n\n"
@@ -266,7 +275,7 @@ static int open_state(struct server *srv, int *lock_fd)
 {
 	const char *state = srv->cfg.state;
 	char msg[SERVER_MESSAGE_MAX], files[SERVER_PATH_MAX];
-	if (fs_make_dirs(state) != 0) {
+	if (fs_make_dirs(state) != 0 || fs_sync_parents(state, 1) != 0) {
 		log_say(LOG_PRIO_ERR, "cannot create state directory '%s': %s", state, strerror(errno));
 		return -1;
 	}
@@ -277,7 +286,7 @@ static int open_state(struct server *srv, int *lock_fd)
 	state_dir_restrict(state);
 	/* /healthz creates its probe file here, so files/ exists before the first upload */
 	snprintf(files, sizeof files, "%s/files", state);
-	if (fs_make_dirs(files) != 0)
+	if (fs_make_dirs(files) != 0 || fs_sync_parents(files, 1) != 0)
 		log_say(LOG_PRIO_WARNING, "cannot create '%s': %s", files, strerror(errno));
 	if (state_dir_open_store(&srv->cfg, srv, &srv->store, msg, sizeof msg) != 0) {
 		log_say(LOG_PRIO_ERR, "%s", msg);
@@ -286,12 +295,12 @@ static int open_state(struct server *srv, int *lock_fd)
 	return 0;
 }
 
-/* Writes the URL to STATE/server.url through a temporary file and a rename. */
-static int write_url(const char *state, const char *url)
+/* Writes the URL to STATE/NAME (server.url, server-tls.url) through a temporary file and a rename. */
+static int write_url(const char *state, const char *name, const char *url)
 {
 	char tmp[SERVER_PATH_MAX + 32], path[SERVER_PATH_MAX + 32];
-	snprintf(tmp, sizeof tmp, "%s/server.url.tmp", state);
-	snprintf(path, sizeof path, "%s/server.url", state);
+	snprintf(tmp, sizeof tmp, "%s/%s.tmp", state, name);
+	snprintf(path, sizeof path, "%s/%s", state, name);
 	int fd = open(tmp, O_WRONLY | O_CREAT | O_TRUNC, 0600);
 	if (fd < 0)
 		return -1;
@@ -357,12 +366,21 @@ static int serve(struct server *srv)
 		close(lock_fd);
 		return 1;
 	}
-	if (write_url(srv->cfg.state, url) != 0)
+	/* server-tls.url first: a script that waits for server.url then finds both */
+	const char *tls_url = http_tls_url(daemon);
+	if (tls_url[0] && write_url(srv->cfg.state, "server-tls.url", tls_url) != 0)
+		log_say(LOG_PRIO_ERR, "cannot write '%s/server-tls.url': %s", srv->cfg.state, strerror(errno));
+	if (write_url(srv->cfg.state, "server.url", url) != 0)
 		log_say(LOG_PRIO_ERR, "cannot write '%s/server.url': %s", srv->cfg.state, strerror(errno));
 	struct reaper *reaper = reaper_start(srv);
 	printf("poro-server listening on %s\n", url);
 	fflush(stdout);
-	log_say(LOG_PRIO_NOTICE, "listening on %s (version %s, state directory '%s')", url, PORO_VERSION, srv->cfg.state);
+	if (tls_url[0])
+		log_say(LOG_PRIO_NOTICE, "listening on %s and %s (version %s, state directory '%s')", url, tls_url,
+			PORO_VERSION, srv->cfg.state);
+	else
+		log_say(LOG_PRIO_NOTICE, "listening on %s (version %s, state directory '%s')", url, PORO_VERSION,
+			srv->cfg.state);
 
 	int sig = 0;
 	sigwait(&signals, &sig);
@@ -387,9 +405,13 @@ int main(int argc, char **argv)
 	signal(SIGXFSZ, SIG_IGN);
 	if (argc >= 2 && strcmp(argv[1], "token") == 0)
 		return token_command(argc, argv, &CONFIG_DEFAULTS);
+	if (argc >= 2 && (strcmp(argv[1], "backup") == 0 || strcmp(argv[1], "restore") == 0))
+		return backup_command(argc, argv, CONFIG_DEFAULTS.state);
 	static struct server srv;
 	if (parse_args(&srv.cfg, argc, argv) != 0)
 		return 2;
+	if (!srv.cfg.web_root[0])
+		web_root_default(srv.cfg.web_root, sizeof srv.cfg.web_root);
 	pthread_mutex_init(&srv.wake_lock, NULL);
 	pthread_cond_init(&srv.claim_cv, NULL);
 	pthread_cond_init(&srv.log_cv, NULL);

@@ -32,6 +32,9 @@ struct worker_seen {
 	char id[SERVER_NAME_MAX + 1];     /* the worker's own id */
 	char user[SERVER_NAME_MAX + 1];   /* the user of its token */
 	long long at_ms;
+	char host[SERVER_NAME_MAX + 1];   /* from its claims, "" before one */
+	int threads;                      /* threads its claims offer, per slot; 0 before one */
+	int claims_waiting;               /* its claims long-polling for work now: its idle slots */
 };
 
 struct metrics {
@@ -118,10 +121,9 @@ void metrics_add_retries(struct metrics *m, int n)
 	pthread_mutex_unlock(&m->lock);
 }
 
-void metrics_worker_seen(struct metrics *m, const char *worker, const char *user)
+/* The slot of (worker, user), taken over from the least recently seen when new; under m->lock. */
+static struct worker_seen *worker_slot(struct metrics *m, const char *worker, const char *user)
 {
-	long long now = now_ms();
-	pthread_mutex_lock(&m->lock);
 	int slot = -1, oldest = 0;
 	for (int i = 0; i < m->worker_count; i++) {
 		if (strcmp(m->workers[i].id, worker) == 0 && strcmp(m->workers[i].user, user) == 0)
@@ -129,12 +131,55 @@ void metrics_worker_seen(struct metrics *m, const char *worker, const char *user
 		if (m->workers[i].at_ms < m->workers[oldest].at_ms)
 			oldest = i;
 	}
-	if (slot < 0)
+	if (slot < 0) {
 		slot = m->worker_count < WORKERS_MAX ? m->worker_count++ : oldest;
-	snprintf(m->workers[slot].id, sizeof m->workers[slot].id, "%s", worker);
-	snprintf(m->workers[slot].user, sizeof m->workers[slot].user, "%s", user);
-	m->workers[slot].at_ms = now;
+		memset(&m->workers[slot], 0, sizeof m->workers[slot]);
+		snprintf(m->workers[slot].id, sizeof m->workers[slot].id, "%s", worker);
+		snprintf(m->workers[slot].user, sizeof m->workers[slot].user, "%s", user);
+	}
+	return &m->workers[slot];
+}
+
+void metrics_worker_seen(struct metrics *m, const char *worker, const char *user)
+{
+	long long now = now_ms();
+	pthread_mutex_lock(&m->lock);
+	worker_slot(m, worker, user)->at_ms = now;
 	pthread_mutex_unlock(&m->lock);
+}
+
+void metrics_worker_claim(struct metrics *m, const char *worker, const char *user, const char *host, int threads,
+			  int delta)
+{
+	long long now = now_ms();
+	pthread_mutex_lock(&m->lock);
+	struct worker_seen *w = worker_slot(m, worker, user);
+	w->at_ms = now;
+	snprintf(w->host, sizeof w->host, "%s", host);
+	w->threads = threads;
+	w->claims_waiting += delta;
+	if (w->claims_waiting < 0)   /* its slot was taken over by another worker meanwhile */
+		w->claims_waiting = 0;
+	pthread_mutex_unlock(&m->lock);
+}
+
+json_t *metrics_workers_json(struct metrics *m)
+{
+	json_t *list = json_array();
+	long long now = now_ms();
+	pthread_mutex_lock(&m->lock);
+	for (int i = 0; list && i < m->worker_count; i++) {
+		const struct worker_seen *w = &m->workers[i];
+		char at[32];
+		format_time(w->at_ms, at);
+		json_array_append_new(list, json_pack("{s:s, s:s, s:o, s:i, s:i, s:s, s:f}", "worker", w->id, "user",
+						      w->user, "host", w->host[0] ? json_string(w->host) : json_null(),
+						      "threads", w->threads, "claims_waiting", w->claims_waiting,
+						      "last_seen_at", at, "seconds_since_seen",
+						      1e-3 * (double)(now - w->at_ms)));
+	}
+	pthread_mutex_unlock(&m->lock);
+	return list;
 }
 
 /* ---- exposition ---- */

@@ -21,6 +21,14 @@ void metrics_add_retries(struct metrics *m, int n);
 /* Records a heartbeat (or claim) of a worker for poro_worker_heartbeat_age_seconds{worker, user}:
  * worker is the id the worker sent, user its token's user. */
 void metrics_worker_seen(struct metrics *m, const char *worker, const char *user);
+/* The same for a claim, which also says the worker's host and the threads a slot offers: delta
+ * +1 when the claim starts waiting for work, -1 when it ends, so that claims_waiting counts the
+ * worker's idle slots (an idle slot long-polls a claim) for the admin view. */
+void metrics_worker_claim(struct metrics *m, const char *worker, const char *user, const char *host, int threads,
+			  int delta);
+/* [{"worker", "user", "host", "threads", "claims_waiting", "last_seen_at", "seconds_since_seen"}]
+ * of the workers remembered (at most 256, the least recently seen replaced first). */
+json_t *metrics_workers_json(struct metrics *m);
 
 /* The exposition text (malloc'ed) with job counts from the store; NULL when out of memory. */
 char *metrics_render(struct metrics *m, struct store *store, size_t *size);

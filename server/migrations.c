@@ -144,6 +144,58 @@ static const char *const MIGRATIONS[] = {
 	"  id INTEGER PRIMARY KEY CHECK (id = 1),"
 	"  checked_at INTEGER NOT NULL,"
 	"  writes INTEGER NOT NULL);",
+
+	/* 4: benchmark nightlies (docs/benchmarks.md). A job may carry the label of the benchmark run
+	 * it belongs to (batch) and ask to run alone on its worker (exclusive). A benchmark run is
+	 * the plan its client submitted (cases, their jobs, each figure's check) and, once finished,
+	 * one row per figure: the samples its jobs reported, the machine fingerprint they were
+	 * measured on, and the verdict. benchmark_figures carries the suite, so that a figure's
+	 * series on one machine, and a timing figure's history, is one range of benchmark_series. */
+	"ALTER TABLE jobs ADD COLUMN batch TEXT;"
+	"ALTER TABLE jobs ADD COLUMN exclusive INTEGER NOT NULL DEFAULT 0;"
+	"CREATE INDEX jobs_batch ON jobs (batch, id) WHERE batch IS NOT NULL;"
+	"CREATE TABLE benchmark_runs ("
+	"  id INTEGER PRIMARY KEY,"
+	"  user_id INTEGER NOT NULL REFERENCES users(id),"
+	"  suite TEXT NOT NULL,"
+	"  label TEXT NOT NULL UNIQUE,"          /* the batch label of its jobs */
+	"  commit_id TEXT NOT NULL,"             /* git describe of the submitting checkout */
+	"  client_host TEXT,"
+	"  solver_version TEXT,"                 /* what the jobs reported */
+	"  machine TEXT,"                        /* JSON: the machine of its timings */
+	"  fingerprint TEXT,"
+	"  state TEXT NOT NULL CHECK (state IN ('running', 'passed', 'regressed', 'failed')),"
+	"  plan TEXT NOT NULL,"                  /* JSON, as checked at creation */
+	"  summary TEXT,"                        /* JSON: figures per verdict */
+	"  created_at INTEGER NOT NULL,"
+	"  finished_at INTEGER);"
+	"CREATE INDEX benchmark_runs_suite ON benchmark_runs (suite, id);"
+	"CREATE TABLE benchmark_figures ("
+	"  run_id INTEGER NOT NULL REFERENCES benchmark_runs(id),"
+	"  figure TEXT NOT NULL,"                /* CASE/KIND */
+	"  suite TEXT NOT NULL,"
+	"  kind TEXT NOT NULL,"
+	"  class TEXT NOT NULL,"                 /* accuracy | timing | count */
+	"  check_kind TEXT NOT NULL,"            /* band | history | none */
+	"  unit TEXT NOT NULL,"
+	"  case_sha256 TEXT,"
+	"  fingerprint TEXT,"                    /* of the machine its samples were measured on */
+	"  samples TEXT NOT NULL,"               /* JSON array of numbers */
+	"  median REAL,"
+	"  band_min REAL,"
+	"  band_max REAL,"
+	"  status TEXT NOT NULL,"                /* regression.h's verdicts */
+	"  detail TEXT,"
+	"  stats TEXT,"                          /* JSON: the rank test's figures */
+	"  PRIMARY KEY (run_id, figure)) WITHOUT ROWID;"
+	"CREATE INDEX benchmark_series ON benchmark_figures (suite, figure, fingerprint, run_id);",
+	/* 5: the dashboard's job search (store_search.c): the case's title beside the job, kept at
+	 * submission, and two covering indexes, so that a filter on state, dates, the job's name or
+	 * the case's title reads index entries alone, never a job's case text */
+	"ALTER TABLE jobs ADD COLUMN case_title TEXT;"
+	"UPDATE jobs SET case_title = json_extract(case_json, '$.title') WHERE json_valid(case_json);"
+	"CREATE INDEX jobs_user_search ON jobs (user_id, id, state, created_at, name, case_title);"
+	"CREATE INDEX jobs_search ON jobs (id, state, created_at, user_id, name, case_title);",
 };
 
 #define MIGRATION_COUNT ((int)(sizeof MIGRATIONS / sizeof MIGRATIONS[0]))

@@ -5,6 +5,7 @@
  */
 #include "server.h"
 
+#include <errno.h>
 #include <stdarg.h>
 #include <stdio.h>
 #include <string.h>
@@ -40,6 +41,11 @@ enum api_code api_fail(struct api_error *err, enum api_code code, const char *fi
 	vsnprintf(err->message, sizeof err->message, fmt, ap);
 	va_end(ap);
 	return code;
+}
+
+enum api_code api_storage_code(int e)
+{
+	return e == ENOSPC || e == EDQUOT || e == EFBIG ? API_INSUFFICIENT_STORAGE : API_UNAVAILABLE;
 }
 
 void api_error_release(struct api_error *err)

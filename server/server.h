@@ -24,6 +24,12 @@
 #define SERVER_MESSAGE_MAX 1024
 
 /* Configuration; defaults in main.c (CONFIG_DEFAULTS) and in `poro-server --help`. */
+/* A job's wall time when its submission names none, s. A claim with seconds_left (a pilot) is given
+ * a job only when the job's wall time fits, except a job with this default: it asked for no
+ * particular time, so any pilot may start it and, when its time runs out first, hand it back with
+ * a checkpoint for the next to resume (docs/slurm.md). */
+#define JOB_WALL_TIME_DEFAULT 86400
+
 struct server_config {
 	char listen[256];             /* HOST:PORT; port 0 picks a free one */
 	char state[SERVER_STATE_MAX];  /* state directory: poro.db, files/, server.url */
@@ -50,6 +56,11 @@ struct server_config {
 	long long max_log_bytes;      /* log text kept per attempt: its first and last half, bytes */
 	long long user_max_stored_bytes; /* default per-user cap on stored bytes; 0 = unlimited */
 	int min_free_mb;              /* /healthz is degraded below this much free space on the state file system, MiB */
+	char web_root[SERVER_STATE_MAX]; /* the dashboard's files (docs/web.md); "" until main.c finds them */
+	char tls_listen[256];         /* HOST:PORT served over TLS (HTTPS), or "" for none */
+	char tls_cert[SERVER_STATE_MAX]; /* PEM certificate chain of --tls-listen */
+	char tls_key[SERVER_STATE_MAX];  /* PEM private key of --tls-listen */
+	int allow_plain_http;         /* 1: --listen may be a non-loopback address (listen_socket.h) */
 };
 
 /*      code                        HTTP  name on the wire */
@@ -73,6 +84,7 @@ struct server_config {
 	X(API_LOG_GAP,              409, "log_gap")                          \
 	X(API_ALREADY_EXISTS,       409, "already_exists")                   \
 	X(API_ARTIFACT_MISSING,     409, "artifact_missing")                 \
+	X(API_NOT_FINISHED,         409, "not_finished")                     \
 	X(API_TOO_LARGE,            413, "body_too_large")                   \
 	X(API_BODY_TOO_COMPLEX,     413, "body_too_complex")                 \
 	X(API_URI_TOO_LONG,         414, "uri_too_long")                     \
@@ -88,6 +100,7 @@ struct server_config {
 	X(API_STORED_FILE_DAMAGED,  500, "stored_file_damaged")              \
 	X(API_NOT_IMPLEMENTED,      501, "not_implemented")                  \
 	X(API_UNAVAILABLE,          503, "unavailable")                      \
+	X(API_INSUFFICIENT_STORAGE, 507, "insufficient_storage")             \
 	X(API_VERSION_NOT_SUPPORTED, 505, "http_version_not_supported")
 
 enum api_code {
@@ -108,6 +121,10 @@ struct api_error {
 enum api_code api_fail(struct api_error *err, enum api_code code, const char *field, const char *fmt, ...)
 	__attribute__((format(printf, 4, 5)));
 void api_error_release(struct api_error *err);
+/* The answer to a failed write, fsync or create on the state file system, by its errno: 507
+ * insufficient_storage for a full disk or quota or a file-size limit (ENOSPC, EDQUOT, EFBIG),
+ * else 503 unavailable (an I/O error). Both are the server's passing state: retry later. */
+enum api_code api_storage_code(int e);
 int api_code_status(enum api_code code);
 const char *api_code_name(enum api_code code);
 

@@ -36,7 +36,7 @@
 
 /* Files of the state directory itself (files/ is walked). */
 static const char *const STATE_FILES[] = { "poro.db", "poro.db-wal", "poro.db-shm", "poro.db-journal",
-					   "server.url", STATE_DIR_LOCK_NAME };
+					   "server.url", "server-tls.url", STATE_DIR_LOCK_NAME };
 
 static int restrict_failures; /* nftw's callback has no argument: the one walk at start-up counts here */
 

@@ -89,8 +89,18 @@ int conn_exec(struct conn *c, const char *sql)
 
 enum api_code db_fail(struct conn *c, struct api_error *err, const char *what)
 {
-	/* out of memory is the server's passing state, not a fault: 503, retry later */
-	enum api_code code = sqlite3_errcode(c->db) == SQLITE_NOMEM ? API_UNAVAILABLE : API_INTERNAL;
+	/* Out of memory, a full disk and an I/O error are the server's passing state, not a fault of
+	 * the request: 503 (507 for the disk), retry later. The transaction was rolled back, so nothing
+	 * was acknowledged, and the next write tries the disk again (docs/hardening.md). */
+	int rc = sqlite3_extended_errcode(c->db);
+	if ((rc & 0xff) == SQLITE_FULL)
+		return api_fail(err, API_INSUFFICIENT_STORAGE, "",
+				"the server's disk is full: database error while %s: %s: retry later", what,
+				sqlite3_errmsg(c->db));
+	if ((rc & 0xff) == SQLITE_IOERR)
+		return api_fail(err, API_UNAVAILABLE, "", "the server's storage failed: database error while %s: %s: retry later",
+				what, sqlite3_errmsg(c->db));
+	enum api_code code = rc == SQLITE_NOMEM ? API_UNAVAILABLE : API_INTERNAL;
 	return api_fail(err, code, "", "database error while %s: %s", what, sqlite3_errmsg(c->db));
 }
 
@@ -162,7 +172,7 @@ static void run_batch(struct store *s, struct write_op *batch)
 		s->wake = 0;
 		for (struct write_op *op = batch; op; op = op->next)
 			if (op->status == API_OK)
-				op->status = api_fail(op->err, API_INTERNAL, "", "%s", e.message);
+				op->status = api_fail(op->err, e.code, "", "%s", e.message);
 	}
 	store_events_flush(s, committed);
 	if (s->observe_commit)

@@ -74,7 +74,10 @@ struct job_submit {
 	const char *case_json;        /* canonical case text */
 	const char *case_sha256;
 	const char *name;             /* or NULL */
+	const char *case_title;       /* the case's "title", or NULL */
 	int priority, threads, wall_time_seconds;
+	const char *batch;            /* the benchmark run's label, or NULL (jobs_submit.h) */
+	int exclusive;                /* 1: runs alone on its worker */
 };
 /* Stores a queued job and its "submitted" event. *created is 1 for a new job, 0 when the
  * idempotency key returned an existing one. API_IDEMPOTENCY_CONFLICT; API_QUOTA_EXCEEDED when the
@@ -89,6 +92,29 @@ enum api_code store_job_get(struct store *s, const struct principal *who, long l
  * combination is an index range scan that stops after limit + 1 rows, without a sort. */
 enum api_code store_job_list(struct store *s, const struct principal *who, unsigned states, int limit,
 			     long long after, json_t **page, struct api_error *err);
+/* The dashboard's search (store_search.c): the filters of GET /v1/jobs beyond state, limit and
+ * after. Strings are NULL when not given; times are ms since the epoch, 0 when not given. */
+struct job_search {
+	unsigned states;              /* JOB_STATE_* bit mask, 0 = all */
+	const char *user;             /* the owner's name (admins; a user sees only its own jobs) */
+	const char *name;             /* a substring of the job's name, any case */
+	const char *title;            /* a substring of the case's title, any case */
+	long long created_from, created_to; /* created_at in [from, to], ms */
+	int oldest_first;             /* 1: ascending ids (after = the last id of the previous page) */
+	int limit;
+	long long after;
+};
+/* A page of jobs by a search, as store_job_list's; each page reads one covering index range
+ * (jobs_user_search for a user, jobs_search for an admin's search of every user), the filters
+ * evaluated on index entries, so a job's case text is never read for a row that is not shown. */
+enum api_code store_job_search(struct store *s, const struct principal *who, const struct job_search *q,
+			       json_t **page, struct api_error *err);
+/* The case text of a job the principal may see, as stored (canonical JSON); the caller frees it. */
+enum api_code store_job_case(struct store *s, const struct principal *who, long long id, char **text,
+			     struct api_error *err);
+/* For the admin view: {"running": [job...]} the running jobs, and "queue": [{"user", "queued",
+ * "running", "max_queued", "max_running"}] the users with queued or running jobs. */
+enum api_code store_admin_overview(struct store *s, json_t **out, struct api_error *err);
 /* Cancels a queued job now, or requests cancel of a running one. API_NOT_CANCELLABLE. */
 enum api_code store_job_cancel(struct store *s, const struct principal *who, long long id, json_t **job,
 			       struct api_error *err);
@@ -137,9 +163,14 @@ enum api_code store_job_counts(struct store *s, long long counts[JOB_STATE_COUNT
 struct job_claim {
 	const struct principal *who;
 	const char *worker, *host;
+	int exclusive_ok;             /* the worker runs nothing now: it may take an exclusive job */
+	long long seconds_left;       /* only jobs whose wall_time_seconds fit this (a pilot's allocation); -1: any */
+	long long max_threads;        /* only jobs asking for at most this many threads; 0: any */
 	long long claim_latency_ms;   /* out: submit (or requeue) to claim */
 };
-/* Leases the next job by fair share (docs/service.md §2); *job is NULL when none is claimable. */
+/* Leases the next job by fair share (docs/service.md §2) among those that fit in->seconds_left
+ * and in->max_threads, leaving exclusive jobs to claims with exclusive_ok; *job is NULL when
+ * none is claimable. */
 enum api_code store_claim(struct store *s, struct job_claim *in, json_t **job, struct api_error *err);
 /* Renews the lease of (id, attempt); progress (object or NULL) and solver_version (or NULL) are
  * recorded. *cancel is 1 when a cancel was requested. */
@@ -213,6 +244,39 @@ enum api_code store_finish(struct store *s, const struct principal *who, long lo
  * overruns failed. Counts what it did. */
 struct reap_counts { int expired, retried, lost, cancelled, overrun; };
 enum api_code store_reap(struct store *s, struct reap_counts *counts, struct api_error *err);
+
+/* ---- benchmark runs (store_bench.c; bench.h says what they are) ----
+ * A run as JSON: {"id", "suite", "label", "commit", "user", "client_host", "state", "solver_version",
+ * "machine", "fingerprint", "summary", "created_at", "finished_at"} and, when full, "settings",
+ * "cases" (the plan's) and "figures" (one row each once finished: {"figure", "case", "kind",
+ * "class", "check", "unit", "case_sha256", "machine", "samples", "median", "band", "status",
+ * "detail", "stats"}). Every user may read every run: they are about the solver, not a user's
+ * work. */
+/* Stores a new running run; API_ALREADY_EXISTS when its label is taken. */
+enum api_code store_bench_create(struct store *s, const struct principal *who, const char *suite, const char *label,
+				 const char *commit, const char *host, const json_t *plan, json_t **run,
+				 struct api_error *err);
+/* A run (full: with its plan and figures); *owner (may be NULL) its user's id. API_NOT_FOUND. */
+enum api_code store_bench_get(struct store *s, long long id, int full, json_t **run, long long *owner,
+			      struct api_error *err);
+/* Runs newest first, of one suite or (suite NULL) all: {"runs": [...], "next_after": ID or null}. */
+enum api_code store_bench_list(struct store *s, const char *suite, int limit, long long after, json_t **page,
+			       struct api_error *err);
+/* The latest limit rows of a figure in a suite, on one machine fingerprint (NULL: every machine),
+ * oldest first: [{"run", "label", "commit", "created_at", "solver_version", "machine", "samples",
+ * "median", "status", "band"}]. */
+enum api_code store_bench_series(struct store *s, const char *suite, const char *figure, const char *fingerprint,
+				 int limit, json_t **points, struct api_error *err);
+/* A timing figure's history: the samples of figure in suite on fingerprint for the same case text,
+ * from the latest `runs` runs before run before_id that measured it (*samples malloc'd, *count
+ * values from *run_count runs). */
+enum api_code store_bench_history(struct store *s, const char *suite, const char *figure, const char *fingerprint,
+				  const char *case_sha256, long long before_id, int runs, double **samples, int *count,
+				  int *run_count, struct api_error *err);
+/* Ends a running run with result {"state", "solver_version", "machine", "fingerprint", "summary",
+ * "figures": [rows as above]}; a run that is no longer running is left as it is (*changed 0). */
+enum api_code store_bench_finish(struct store *s, long long id, const json_t *result, int *changed,
+				 struct api_error *err);
 
 /* Seconds of writer transactions, for the poro_commit_seconds histogram (set by the writer). */
 void store_set_commit_observer(struct store *s, void (*observe)(void *cls, double seconds), void *cls);

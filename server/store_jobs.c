@@ -95,7 +95,7 @@ json_t *job_from_row(struct store *s, sqlite3_stmt *st)
 			progress = parsed;
 		}
 	}
-	return json_pack("{s:I, s:o, s:o, s:o, s:i, s:i, s:i, s:i, s:o, s:o, s:o, s:o, s:o, s:o, s:o, s:o, s:b, s:o}",
+	json_t *job = json_pack("{s:I, s:o, s:o, s:o, s:i, s:i, s:i, s:i, s:o, s:o, s:o, s:o, s:o, s:o, s:o, s:o, s:b, s:o}",
 			 "id", (json_int_t)sqlite3_column_int64(st, 0), "user", col_json_text(st, 1),
 			 "name", col_json_text(st, 2), "state", col_json_text(st, 3),
 			 "priority", sqlite3_column_int(st, 4), "threads", sqlite3_column_int(st, 5),
@@ -105,6 +105,12 @@ json_t *job_from_row(struct store *s, sqlite3_stmt *st)
 			 "solver_version", col_json_text(st, 12), "worker_host", col_json_text(st, 13),
 			 "progress", progress, "message", col_json_text(st, 15),
 			 "cancel_requested", sqlite3_column_int(st, 16), "waiting", job_waiting(s, st));
+	/* the benchmark nightlies' batch label and exclusive flag (docs/benchmarks.md) */
+	json_object_set_new(job, "batch", col_json_text(st, 21));
+	json_object_set_new(job, "exclusive", json_boolean(sqlite3_column_int(st, 22)));
+	/* the case's title, kept beside the job for the dashboard's search (store_search.c) */
+	json_object_set_new(job, "case_title", col_json_text(st, 23));
+	return job;
 }
 
 static const char SQL_JOB[] = "SELECT " JOB_COLUMNS "FROM jobs j JOIN users u ON u.id = j.user_id WHERE j.id = ?1";
@@ -337,12 +343,17 @@ static enum api_code submit_run(struct store *s, struct conn *c, void *arg, stru
 	    (rc = next_job_id(c, &id, err)) != API_OK)
 		return rc;
 	sqlite3_stmt *st = conn_stmt(c, "INSERT INTO jobs (user_id, name, state, priority, threads, wall_time_seconds,"
-					" case_json, case_sha256, created_at, queued_at, id, stored_bytes)"
-					" VALUES (?1, ?2, 'queued', ?3, ?4, ?5, ?6, ?7, ?8, ?8, ?9, ?10)");
+					" case_json, case_sha256, created_at, queued_at, id, stored_bytes, batch, exclusive, case_title)"
+					" VALUES (?1, ?2, 'queued', ?3, ?4, ?5, ?6, ?7, ?8, ?8, ?9, ?10, ?11, ?12, ?13)");
 	if (!st)
 		return db_fail(c, err, "preparing a job insert");
 	sqlite3_bind_int64(st, 9, id);
 	sqlite3_bind_int64(st, 10, case_bytes);
+	if (in->batch)
+		sqlite3_bind_text(st, 11, in->batch, -1, SQLITE_STATIC);
+	sqlite3_bind_int(st, 12, in->exclusive != 0);
+	if (in->case_title)
+		sqlite3_bind_text(st, 13, in->case_title, -1, SQLITE_STATIC);
 	sqlite3_bind_int64(st, 1, in->who->user_id);
 	if (in->name)
 		sqlite3_bind_text(st, 2, in->name, -1, SQLITE_STATIC);

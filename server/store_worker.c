@@ -100,18 +100,30 @@ struct claim_op {
 	json_t *job;
 };
 
-static enum api_code pick(struct store *s, struct conn *c, long long now, long long *id, struct api_error *err)
+/* Claims with exclusive_ok take exclusive jobs too. seconds_left < 0 lets any job fit; otherwise
+ * only jobs whose wall_time_seconds fit (a pilot whose allocation ends sooner must not start what
+ * it cannot finish), and jobs that asked for no wall time (JOB_WALL_TIME_DEFAULT, server.h), which
+ * move from pilot to pilot by checkpoints; max_threads > 0 likewise leaves out jobs asking for
+ * more threads than the worker has. */
+static enum api_code pick(struct store *s, struct conn *c, long long now, const struct job_claim *in, long long *id,
+			  struct api_error *err)
 {
 	*id = 0;
 	sqlite3_stmt *st = conn_stmt(c,
 		"SELECT u.id FROM users u WHERE u.queued > 0"
 		" AND (coalesce(u.max_running, ?2) = 0 OR u.running < coalesce(u.max_running, ?2))"
-		" AND EXISTS (SELECT 1 FROM jobs j WHERE j.user_id = u.id AND j.state = 'queued' AND j.not_before <= ?1)"
+		" AND EXISTS (SELECT 1 FROM jobs j WHERE j.user_id = u.id AND j.state = 'queued' AND j.not_before <= ?1"
+		"             AND (?3 OR j.exclusive = 0)"
+		" AND (?4 < 0 OR j.wall_time_seconds <= ?4 OR j.wall_time_seconds = ?5) AND (?6 = 0 OR j.threads <= ?6))"
 		" ORDER BY u.running, u.last_claim_seq, u.id LIMIT 1");
 	if (!st)
 		return db_fail(c, err, "choosing a user");
 	sqlite3_bind_int64(st, 1, now);
 	sqlite3_bind_int(st, 2, s->cfg->user_max_running);
+	sqlite3_bind_int(st, 3, in->exclusive_ok);
+	sqlite3_bind_int64(st, 4, in->seconds_left);
+	sqlite3_bind_int(st, 5, JOB_WALL_TIME_DEFAULT);
+	sqlite3_bind_int64(st, 6, in->max_threads);
 	long long user = 0;
 	if (sqlite3_step(st) == SQLITE_ROW)
 		user = sqlite3_column_int64(st, 0);
@@ -119,11 +131,17 @@ static enum api_code pick(struct store *s, struct conn *c, long long now, long l
 	if (!user)
 		return API_OK;
 	st = conn_stmt(c, "SELECT id FROM jobs WHERE user_id = ?1 AND state = 'queued' AND not_before <= ?2"
+			  " AND (?3 OR exclusive = 0)"
+			  " AND (?4 < 0 OR wall_time_seconds <= ?4 OR wall_time_seconds = ?5) AND (?6 = 0 OR threads <= ?6)"
 			  " ORDER BY priority DESC, id LIMIT 1");
 	if (!st)
 		return db_fail(c, err, "choosing a job");
 	sqlite3_bind_int64(st, 1, user);
 	sqlite3_bind_int64(st, 2, now);
+	sqlite3_bind_int(st, 3, in->exclusive_ok);
+	sqlite3_bind_int64(st, 4, in->seconds_left);
+	sqlite3_bind_int(st, 5, JOB_WALL_TIME_DEFAULT);
+	sqlite3_bind_int64(st, 6, in->max_threads);
 	if (sqlite3_step(st) == SQLITE_ROW)
 		*id = sqlite3_column_int64(st, 0);
 	sqlite3_reset(st);
@@ -156,13 +174,13 @@ static enum api_code claim_run(struct store *s, struct conn *c, void *arg, struc
 {
 	struct claim_op *op = arg;
 	long long now = now_ms(), id;
-	enum api_code rc = pick(s, c, now, &id, err);
+	enum api_code rc = pick(s, c, now, op->in, &id, err);
 	if (rc != API_OK || !id)
 		return rc;
 	sqlite3_stmt *st = conn_stmt(c, "UPDATE jobs SET attempt = attempt + 1, started_at = ?2, lease_expires_at = ?3,"
 					" worker = ?4, worker_host = ?5, lease_user_id = ?6, cancel_requested = 0,"
 					" progress = NULL WHERE id = ?1"
-					" RETURNING attempt, case_json, threads, wall_time_seconds, queued_at");
+					" RETURNING attempt, case_json, threads, wall_time_seconds, queued_at, exclusive");
 	if (!st)
 		return db_fail(c, err, "preparing a claim");
 	sqlite3_bind_int64(st, 1, id);
@@ -181,6 +199,7 @@ static enum api_code claim_run(struct store *s, struct conn *c, void *arg, struc
 			    case_spec ? case_spec : json_null(), "threads", sqlite3_column_int(st, 2),
 			    "wall_time_seconds", sqlite3_column_int(st, 3), "lease_seconds", s->cfg->lease_seconds);
 	op->in->claim_latency_ms = now - sqlite3_column_int64(st, 4);
+	json_object_set_new(op->job, "exclusive", json_boolean(sqlite3_column_int(st, 5)));
 	sqlite3_step(st); /* a RETURNING statement completes its update on the step that returns DONE */
 	sqlite3_reset(st);
 	json_object_set_new(op->job, "checkpoint", checkpoint_of(c, id, attempt));
@@ -596,7 +615,7 @@ static enum api_code file_run(struct store *s, struct conn *c, void *arg, struct
 	if ((rc = step_done(c, st, err, "indexing a file")) != API_OK)
 		return rc;
 	if (rename(op->tmp_path, op->final_path) != 0 || fsync_dir_of(op->final_path) != 0)
-		return api_fail(err, API_INTERNAL, "", "cannot store file '%s': %s", op->name, strerror(errno));
+		return api_fail(err, api_storage_code(errno), "", "cannot store file '%s': %s", op->name, strerror(errno));
 	return API_OK;
 }
 

@@ -56,23 +56,36 @@ static void wait_for_work(struct server *srv, unsigned long long seq, long long 
 
 void worker_claim(struct request *r)
 {
-	static const char *const keys[] = { "worker", "host", "threads", "wait_seconds", NULL };
+	static const char *const keys[] = { "worker", "host", "threads", "wait_seconds", "exclusive", "seconds_left",
+					    "max_threads", NULL };
 	json_t *body = api_body_object(r);
 	if (!body)
 		return;
 	const char *worker, *host;
-	long long threads, wait;
+	long long threads, wait, seconds_left, max_threads;
 	if (api_known_keys(r, body, keys) || api_string_member(r, body, "worker", SERVER_NAME_MAX, 1, &worker) ||
 	    api_string_member(r, body, "host", SERVER_NAME_MAX, 0, &host) ||
 	    api_int_member(r, body, "threads", 1, THREADS_MAX, 1, &threads) ||
-	    api_int_member(r, body, "wait_seconds", 0, WAIT_SECONDS_MAX, 0, &wait)) {
+	    api_int_member(r, body, "wait_seconds", 0, WAIT_SECONDS_MAX, 0, &wait) ||
+	    api_int_member(r, body, "seconds_left", 0, 1LL << 40, -1, &seconds_left) ||
+	    api_int_member(r, body, "max_threads", 1, THREADS_MAX, 0, &max_threads)) {
+		json_decref(body);
+		return;
+	}
+	/* "exclusive": true says the worker runs nothing now and may take an exclusive job (a worker
+	 * that does not say so never gets one) */
+	json_t *exclusive = json_object_get(body, "exclusive");
+	if (exclusive && !json_is_boolean(exclusive) && !json_is_null(exclusive)) {
+		reply_fail(r, API_INVALID_REQUEST, "/exclusive", "'exclusive' must be true or false");
 		json_decref(body);
 		return;
 	}
 	struct server *srv = r->srv;
-	struct job_claim in = { .who = &r->who, .worker = worker, .host = host ? host : worker };
+	struct job_claim in = { .who = &r->who, .worker = worker, .host = host ? host : worker,
+				.exclusive_ok = json_is_true(exclusive), .seconds_left = seconds_left,
+				.max_threads = max_threads };
 	long long deadline = now_ms() + 1000 * wait;
-	metrics_worker_seen(srv->metrics, worker, r->who.name);
+	metrics_worker_claim(srv->metrics, worker, r->who.name, in.host, (int)threads, 1);
 	server_worker_seen(srv);
 	atomic_fetch_add(&srv->claims_waiting, 1);
 	for (;;) {
@@ -101,6 +114,7 @@ void worker_claim(struct request *r)
 		wait_for_work(srv, seq, deadline);
 	}
 	atomic_fetch_sub(&srv->claims_waiting, 1);
+	metrics_worker_claim(srv->metrics, worker, r->who.name, in.host, (int)threads, -1);
 	server_worker_seen(srv);
 	json_decref(body);
 }

@@ -104,15 +104,37 @@ typedef void (*sim_progress_fn)(const struct sim_progress *p, void *user);
 
 /* Runs to the end time writing out_dir/result.h5 and result.xdmf (frames at the case's
  * frame_interval, probes every step); calls progress every progress_interval of wall time and
- * at the end. stop (may be NULL) is polled each step: non-zero interrupts with PORO_EINTERRUPTED.
+ * at the end. stop (may be NULL) is polled each step: non-zero interrupts with PORO_EINTERRUPTED;
+ * SIM_STOP_CHECKPOINT writes a checkpoint of the current step first, so that the run can be
+ * resumed elsewhere without losing work (a worker whose allocation ends hands its job back so).
  * Writes out_dir/checkpoint.h5 every checkpoint.interval of simulated time (case) or every
  * sim_set_checkpoint_wall() seconds of wall time, whichever comes first, and calls progress with
  * checkpoint = 1 after each. A sim loaded from a checkpoint (checkpoint_load) continues from its
  * step and continues out_dir/result.h5 when it exists (run.c says how). */
+#define SIM_STOP_CHECKPOINT 2
 enum poro_status sim_run(struct sim *s, const char *out_dir, const char *solver_version,
 			 sim_progress_fn progress, void *user, volatile int *stop);
 
 /* Wall-clock interval between checkpoints in sim_run, s; 0 (the default) = by simulated time only. */
 void sim_set_checkpoint_wall(struct sim *s, double seconds);
+
+/* What the steps sim_run took in this process cost (a resumed run counts from its checkpoint):
+ * wall and processor seconds (CLOCK_PROCESS_CPUTIME_ID: every thread), the steps, and the points
+ * stepped (soil plus water points), for the timing figures (figures.h). Frames, probes and
+ * checkpoints between the steps are not counted. */
+struct sim_timing {
+	double wall_seconds, cpu_seconds;
+	double median_step_cpu;          /* s: the median step's processor time (step_timing.h) */
+	long steps;
+	long points;
+};
+void sim_get_timing(const struct sim *s, struct sim_timing *t);
+
+/* A test knob, never set by a case (docs/benchmarks.md, "Test knobs"): with factor > 1 sim_run
+ * repeats, before each step, the step's first phase (the shape functions at the points' present
+ * positions, which the step then computes again from the same positions) until that costs
+ * (factor - 1) times the previous step's processor time, so each step costs about factor times
+ * as much and every result stays bit-identical. 1 (the default) is off. */
+void sim_set_slowdown(struct sim *s, double factor);
 
 #endif

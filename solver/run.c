@@ -16,6 +16,11 @@
  * run. If DIR/result.h5 exists, its frames and samples up to the checkpoint time are kept and the
  * run appends to it; otherwise a new result.h5 begins with a frame and a probe sample at the
  * checkpoint time.
+ *
+ * The steps' own cost is measured around each sim_step (sim_get_timing): wall time and the
+ * process's processor time, without the frames, probes and checkpoints between steps, which
+ * depend on the disk more than on the solver. The slowdown knob (sim_set_slowdown) is counted
+ * with its step: it stands for a slower step.
  */
 #include <errno.h>
 #include <math.h>
@@ -27,6 +32,7 @@
 
 #include "checkpoint.h"
 #include "output.h"
+#include "phases.h"
 #include "sim_internal.h"
 
 #define PROBE_SAMPLES_TARGET 20000
@@ -36,6 +42,52 @@ static double wall_now(void)
 	struct timespec ts;
 	clock_gettime(CLOCK_MONOTONIC, &ts);
 	return ts.tv_sec + 1e-9 * ts.tv_nsec;
+}
+
+/* Processor time of the process (every thread), s. */
+static double cpu_now(void)
+{
+	struct timespec ts;
+	clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
+	return ts.tv_sec + 1e-9 * ts.tv_nsec;
+}
+
+void sim_set_slowdown(struct sim *s, double factor) { s->slowdown = factor > 1 ? factor : 1; }
+
+void sim_get_timing(const struct sim *s, struct sim_timing *t)
+{
+	*t = s->timing;
+	t->points = (long)s->soil.n + (s->double_point ? (long)s->water.n : 0);
+	t->median_step_cpu = step_histogram_median(&s->step_cpu);
+}
+
+/* The slowdown knob: step 1 (the shape functions at the present positions, which the step about
+ * to be taken computes again from the same positions) repeated for (slowdown - 1) times the
+ * processor time of the previous step. */
+static enum poro_status slow_down(struct sim *s, double previous_step_cpu)
+{
+	double t0 = cpu_now(), want = (s->slowdown - 1) * previous_step_cpu;
+	while (cpu_now() - t0 < want)
+		TRY(point_map_shapes(s));
+	return PORO_OK;
+}
+
+/* One step, timed (sim_get_timing), after the slowdown knob's repeats. */
+static enum poro_status timed_step(struct sim *s, double *last_cpu)
+{
+	double c0 = cpu_now(), w0 = wall_now();
+	enum poro_status st = s->slowdown > 1 && *last_cpu > 0 ? slow_down(s, *last_cpu) : PORO_OK;
+	double c1 = cpu_now();
+	if (!st)
+		st = sim_step(s);
+	double c2 = cpu_now();
+	*last_cpu = c2 - c1;
+	if (!st)
+		step_histogram_add(&s->step_cpu, c2 - c0);
+	s->timing.cpu_seconds += c2 - c0;
+	s->timing.wall_seconds += wall_now() - w0;
+	s->timing.steps += !st;
+	return st;
 }
 
 static enum poro_status write_frame(struct sim *s, struct output *o)
@@ -142,13 +194,15 @@ enum poro_status sim_run(struct sim *s, const char *out_dir, const char *solver_
 	const long step0 = s->step;
 	int appended = 0;
 	double *values = calloc((size_t)s->spec->probe_count + 1, sizeof(double));
-	if (!values)
-		return poro_error_set(&s->err, PORO_ENOMEM, "cannot allocate probe values");
+	if (!values || (!s->step_cpu.count && step_histogram_init(&s->step_cpu))) {
+		free(values);
+		return poro_error_set(&s->err, PORO_ENOMEM, "cannot allocate probe values and step times");
+	}
 	enum poro_status st = open_output(s, out_dir, solver_version, &o, &appended);
 	const double interval = s->spec->output.frame_interval;
 	const double checkpoint_interval = s->spec->checkpoint.interval;
 	const long thin = s->steps_total / PROBE_SAMPLES_TARGET + 1;
-	double last_report = t0, last_checkpoint = t0;
+	double last_report = t0, last_checkpoint = t0, last_step_cpu = 0;
 	long next_frame = next_multiple(s->time, interval);
 	long next_checkpoint = next_multiple(s->time, checkpoint_interval);
 	if (!st && !appended)
@@ -157,11 +211,14 @@ enum poro_status sim_run(struct sim *s, const char *out_dir, const char *solver_
 		st = sample_probes(s, o, values);
 	while (!st && !sim_done(s)) {
 		if (stop && *stop) {
-			st = poro_error_set(&s->err, PORO_EINTERRUPTED, "interrupted at step %ld (t = %.6g s)",
+			if (*stop == SIM_STOP_CHECKPOINT && s->step > step0)
+				st = checkpoint(s, o, out_dir, progress, user, t0, step0);
+			if (!st)
+				st = poro_error_set(&s->err, PORO_EINTERRUPTED, "interrupted at step %ld (t = %.6g s)",
 					    s->step, s->time);
 			break;
 		}
-		st = sim_step(s);
+		st = timed_step(s, &last_step_cpu);
 		if (st)
 			break;
 		if (s->step % thin == 0 || sim_done(s))

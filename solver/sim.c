@@ -290,6 +290,7 @@ void sim_destroy(struct sim **ps)
 		return;
 	particles_release(&s->water);
 	particles_release(&s->soil);
+	step_histogram_release(&s->step_cpu);
 	if (s->scheme)
 		s->scheme->destroy(s);
 	grid_fields_release(&s->f);

@@ -13,6 +13,7 @@
 #include "permeability.h"
 #include "poro.h"
 #include "stable_dt.h"
+#include "step_timing.h"
 
 /* Returns from the calling function with a phase's status unless it is PORO_OK. */
 #define TRY(call)                                       \
@@ -61,6 +62,9 @@ struct sim {
 	int *probe_point;             /* [probe_count] tracked point of point probes, -1 otherwise */
 	int resumed;                  /* 1: the state was loaded from a checkpoint (checkpoint.c) */
 	double checkpoint_wall;       /* s of wall time between checkpoints in sim_run; 0 = none */
+	struct sim_timing timing;     /* the steps sim_run took in this process (run.c) */
+	struct step_histogram step_cpu; /* their processor times (step_timing.h), allocated by sim_run */
+	double slowdown;              /* test knob of sim_set_slowdown (run.c); 1 = off */
 	struct poro_error err;
 };
 

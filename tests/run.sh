@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Runs the test programs and prints one closing line "N passed, N failed, N skipped".
 #   tests/run.sh BUILD_DIR test     unit tests, reduced-size verification, command-line tests,
-#                                   the build and install tests (tests/install)
+#                                   the build and install tests (tests/install), the fault,
+#                                   power-loss and short soak tests (tests/fault)
 #   tests/run.sh BUILD_DIR verify   the verification runs alone (tests/verify/); the cases there
 #                                   are already at the papers' sizes, so `make test` includes them,
 #                                   except runs a program keeps for PORO_VERIFY_LONG=1, which this
@@ -32,7 +33,9 @@ if [ "$mode" = test ]; then
 	for t in "$build"/tests/verify/*_test "$build"/tests/solver/*_test "$build"/tests/common/*_test; do
 		[ -x "$t" ] && parallel+=("$t")
 	done
-	for t in tests/cli/*_test.sh tests/install/*_test.sh; do [ -f "$t" ] && serial+=("bash $t $build"); done
+	for t in tests/cli/*_test.sh tests/install/*_test.sh tests/web/*_test.sh; do [ -f "$t" ] && serial+=("bash $t $build"); done
+	# fault injection, power loss and the short soak (docs/hardening.md)
+	for t in tests/fault/*_test.sh; do [ -f "$t" ] && serial+=("bash $t $build"); done
 elif [ "$mode" = service ]; then
 	for t in "$build"/tests/common/*_test; do [ -x "$t" ] && parallel+=("$t"); done
 else

@@ -77,6 +77,7 @@ echo "results:  $dir/result.h5"
 echo "ParaView: $dir/result.xdmf"
 "$build/terzaghi-error" runs/terzaghi || exit 1
 echo
+echo "The dashboard: $url/ (sign in with the token in $state/tokens/user.token)"
 echo "The service keeps running; Ctrl-C stops it. From another shell:"
 echo "  export PORO_SERVER=$url PORO_TOKEN=\$(cat $PWD/$state/tokens/user.token)"
 echo "  $build/poro submit tests/cases/xie_leo.json --wait"

@@ -3,12 +3,14 @@
  * Terzaghi's closed form.
  *
  *   terzaghi-error DIR     reads DIR/result.h5 and prints one line, e.g.
- *   terzaghi: t = 0.981 s (Tv = 1.000), RMS pore-pressure error 0.26% of q over 640 points
+ *   terzaghi: t = 0.981 s, RMS pore-pressure error 0.26% of q over 640 points
  *
  * The case is taken from the file's /case, so the command needs nothing but the run directory.
  * For the last frame it computes the RMS over the points that carry pore pressure (the water set
- * in double point, the soil set in single point) of (p - p_Terzaghi) / q, the measure of 000
- * §5.1 and tests/verify/consolidation_test.c. Symbols as in the paper (000 Eqs. 84-86):
+ * in double point, the soil set in single point) of (p - p_Terzaghi) / q, each point at the soil's
+ * reference height there, the measure of 000 §5.1 and tests/verify/consolidation_test.c, with the
+ * solver's own figure function (figures.h: the terzaghi_rms a run reports in its metrics.json is
+ * this number). Symbols as in the paper (000 Eqs. 84-86):
  *   q    magnitude of the first load's traction, Pa (a step load)
  *   H    height of the first body (the column), m; the drainage length Hd is H, or H/2 when the
  *        bottom face is drained too
@@ -24,22 +26,13 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "../tests/verify/analytic.h"
 #include "case.h"
+#include "figures.h"
+#include "particles.h"
 #include "results_read.h"
 
-#define G 9.81                 /* gravitational acceleration in c_v, m/s^2 (000 Eq. 85) */
 #define EXIT_INVALID 2
 #define PATH_MAX_LEN 4096
-
-/* The column as the closed form sees it. */
-struct column {
-	double q;              /* load, Pa */
-	double top, bottom;    /* y of the body's top and bottom faces, m */
-	double Hd;             /* drainage length, m */
-	double cv;             /* consolidation coefficient, m^2/s */
-	int drained_both;      /* the bottom face drains too */
-};
 
 static int fail(const char *what, const char *detail)
 {
@@ -47,64 +40,43 @@ static int fail(const char *what, const char *detail)
 	return EXIT_INVALID;
 }
 
-static int column_of(const struct case_spec *c, struct column *col)
-{
-	if (c->load_count < 1 || c->body_count < 1)
-		return -1;
-	const struct case_material *m = &c->materials[c->bodies[0].material];
-	const struct case_body *b = &c->bodies[0];
-	double nu = m->poisson_ratio, E = m->youngs_modulus;
-	double mv = (1 + nu) * (1 - 2 * nu) / ((1 - nu) * E);    /* 000 Eq. 86 */
-	col->q = hypot(c->loads[0].traction[0], c->loads[0].traction[1]);
-	col->top = b->max[1];
-	col->bottom = b->min[1];
-	col->drained_both = c->boundaries[FACE_BOTTOM].drainage == DRAINAGE_DRAINED;
-	col->Hd = (col->top - col->bottom) / (col->drained_both ? 2 : 1);
-	col->cv = b->hydraulic_conductivity / (c->fluid.density * G * mv);
-	return col->q > 0 && col->Hd > 0 ? 0 : -1;
-}
-
-/* RMS of (p - p_Terzaghi) / q over n points at positions x[2n]. */
-static double rms_error(const struct column *col, double Tv, const double *p, const double *x, long n)
-{
-	double sum = 0.0;
-	for (long i = 0; i < n; i++) {
-		double y = x[2 * i + 1], z = col->top - y;
-		if (col->drained_both)
-			z = fmin(z, y - col->bottom);
-		double e = (p[i] - terzaghi_pressure(z, col->Hd, Tv, col->q)) / col->q;
-		sum += e * e;
-	}
-	return sqrt(sum / (double)n);
-}
-
-/* Reads the pressure-carrying set of the last frame and prints the line. */
-static int report(struct results *r, const struct case_spec *c, const struct column *col)
+/* Reads the last frame: the pressure-carrying set (p, x) and the soil set (x, displacement), from
+ * which the soil's reference positions x0 = x - displacement give each point's reference height. */
+static int report(struct results *r, const struct case_spec *c)
 {
 	struct poro_error err = {0};
 	long last = results_frame_count(r) - 1;
 	const char *set = c->formulation.phases == PHASES_DOUBLE_POINT ? "water" : "soil";
-	double t = 0, *p = NULL, *x = NULL;
-	long n = 0, nx = 0;
-	int width = 0;
+	double t = 0, *p = NULL, *x = NULL, *sx = NULL, *su = NULL;
+	long n = 0, nx = 0, ns = 0, nu = 0;
+	int width = 0, swidth = 0, uwidth = 0;
 	if (last < 0)
 		return fail("no frames in the result", NULL);
 	int rc = EXIT_INVALID;
 	if (results_frame_time(r, last, &t, &err) ||
 	    results_frame_read(r, last, set, "pore_pressure", &p, &n, NULL, &err) ||
-	    results_frame_read(r, last, set, "x", &x, &nx, &width, &err))
+	    results_frame_read(r, last, set, "x", &x, &nx, &width, &err) ||
+	    results_frame_read(r, last, "soil", "x", &sx, &ns, &swidth, &err) ||
+	    results_frame_read(r, last, "soil", "displacement", &su, &nu, &uwidth, &err))
 		fail("cannot read the last frame", err.message);
-	else if (nx != n || width != 2 || n == 0)
-		fail("the last frame has no pressure-carrying points, or x and pore_pressure disagree", NULL);
+	else if (nx != n || width != 2 || n == 0 || ns != nu || swidth != 2 || uwidth != 2 || ns == 0)
+		fail("the last frame has no pressure-carrying points, or its arrays disagree", NULL);
 	else
 		rc = 0;
 	if (!rc) {
-		double Tv = col->cv * t / (col->Hd * col->Hd);
-		printf("terzaghi: t = %.4g s (Tv = %.3f), RMS pore-pressure error %.2f%% of q over %ld points\n", t,
-		       Tv, 100.0 * rms_error(col, Tv, p, x, n), n);
+		for (long i = 0; i < 2 * ns; i++)
+			su[i] = sx[i] - su[i];    /* the reference positions */
+		struct particles soil = { .n = (idx_t)ns, .x = sx, .x0 = su };
+		double rms = figure_terzaghi_rms(c, &soil, t, p, x, n);
+		if (isnan(rms))
+			rc = fail("the case is not a loaded consolidation column", c->title);
+		else
+			printf("terzaghi: t = %.4g s, RMS pore-pressure error %.2f%% of q over %ld points\n", t, 100.0 * rms, n);
 	}
 	free(p);
 	free(x);
+	free(sx);
+	free(su);
 	return rc;
 }
 
@@ -122,14 +94,11 @@ int main(int argc, char **argv)
 	if (results_open(&r, path, &err))
 		return fail("no readable result", err.message);
 	struct case_spec *c = NULL;
-	struct column col;
 	int rc;
 	if (case_load_string(results_case_json(r), &c, &err))
 		rc = fail("the case stored in the result does not load", err.message);
-	else if (column_of(c, &col))
-		rc = fail("the case is not a loaded consolidation column", c->title);
 	else
-		rc = report(r, c, &col);
+		rc = report(r, c);
 	case_destroy(&c);
 	results_close(&r);
 	return rc;

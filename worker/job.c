@@ -14,8 +14,9 @@
  * get there turns "succeeded" into "failed" when the server refused it (413, 422: a retry would end
  * the same way) or "infrastructure" when it kept failing until WORKER_FINISH_PATIENCE ran out; the
  * job directory is then kept, whatever --keep-work says, and the message says where. Each staged
- * result.h5 gets its probes.json from a `poro-solve probes` child (probes.h), uploaded right after
- * it; a failed extraction costs only the probes.
+ * result.h5 gets its probes.json, and the dashboard's frames.bin and frames.json, from a
+ * `poro-solve probes` child (probes.h), uploaded right after it; a failed extraction costs only
+ * those derived files.
  */
 #define _GNU_SOURCE
 #include "job.h"
@@ -44,12 +45,15 @@
 /* Seconds the finish call still gets when the final uploads used up WORKER_FINISH_PATIENCE: an
  * attempt whose files could not be sent is reported, not left to expire. */
 #define JOB_REPORT_PATIENCE 60.0
-/* Files a finish declares: result.h5, probes.json, result.xdmf, checkpoint.h5. */
-#define JOB_ARTIFACTS_MAX 4
+/* Files a finish declares: result.h5, probes.json, frames.bin, frames.json, metrics.json,
+ * result.xdmf, checkpoint.h5. */
+#define JOB_ARTIFACTS_MAX 7
 #define JOB_PROBES_NAME "probes.json"
+#define JOB_FRAMES_BIN "frames.bin"      /* the frames in the dashboard's compact form (probes.h) */
+#define JOB_FRAMES_INDEX "frames.json"   /* their index, uploaded after frames.bin */
 #define JOB_TEXT_MAX 8192   /* bytes of a message about the files, as the server's MESSAGE_MAX */
 
-enum stop_reason { STOP_NONE, STOP_CANCEL, STOP_WALL, STOP_SHUTDOWN, STOP_LOST };
+enum stop_reason { STOP_NONE, STOP_CANCEL, STOP_WALL, STOP_SHUTDOWN, STOP_LOST, STOP_RETIRE };
 enum send_result { SEND_OK, SEND_RETRY, SEND_REFUSED, SEND_LOST };
 
 /* A result file staged for upload: a snapshot path and its checksum. */
@@ -92,7 +96,7 @@ struct job {
 	double next_heartbeat_at;
 	int checkpoints_seen;
 	/* result.h5 goes first, so it is never older; its probes.json follows once extracted */
-	struct staged up_result, up_checkpoint, up_probes;
+	struct staged up_result, up_checkpoint, up_probes, up_frames_bin, up_frames_index;
 	struct probes_run probes;
 	char upload_why[700];    /* the answer (or transport error) of the last failed upload */
 
@@ -245,12 +249,26 @@ static int stage(struct job *j, const char *name, struct staged *f, int snapshot
 static void start_probes(struct job *j, const char *result, char *note, size_t note_size)
 {
 	char err[700];
-	j->up_probes.pending = 0;
+	j->up_probes.pending = j->up_frames_bin.pending = j->up_frames_index.pending = 0;
 	if (probes_start(&j->probes, j->dir, result, j->id, j->attempt, err, sizeof err) == 0)
 		return;
 	worker_say("%s: no probes.json for '%s': cannot start poro-solve probes: %s", j->tag, result, err);
 	if (note)
 		snprintf(note, note_size, "no probes.json: cannot start poro-solve probes: %s", err);
+}
+
+/* Stages the frames the extraction wrote beside probes.json, when it wrote them (derived data:
+ * a job without them only has no field viewer). */
+static void stage_frames(struct job *j)
+{
+	struct staged *f[2] = { &j->up_frames_bin, &j->up_frames_index };
+	const char *name[2] = { PROBES_FRAMES_BIN, PROBES_FRAMES_INDEX };
+	for (int i = 0; i < 2; i++) {
+		snprintf(f[i]->path, sizeof f[i]->path, "%s/%s", j->dir, name[i]);
+		f[i]->pending = digest_file_hex(f[i]->path, f[i]->sha256, &f[i]->size) == 0;
+	}
+	if (!f[1]->pending)   /* an index without its frames, or frames without an index, is of no use */
+		f[0]->pending = 0;
 }
 
 /* Polls the extraction: PROBES_DONE with probes.json staged in f; PROBES_FAILED said, and kept in
@@ -261,6 +279,7 @@ static enum probes_state collect_probes(struct job *j, struct staged *f, double 
 	enum probes_state st = probes_poll(&j->probes, now, why, sizeof why);
 	if (st == PROBES_DONE) {
 		snprintf(f->path, sizeof f->path, "%s/%s", j->dir, PROBES_OUT);
+		stage_frames(j);
 		if (digest_file_hex(f->path, f->sha256, &f->size) == 0) {
 			f->pending = 1;
 		} else {
@@ -269,6 +288,12 @@ static enum probes_state collect_probes(struct job *j, struct staged *f, double 
 		}
 	}
 	if (st == PROBES_FAILED) {
+		snprintf(f->path, sizeof f->path, "%s/%s", j->dir, PROBES_OUT);
+		if (digest_file_hex(f->path, f->sha256, &f->size) == 0) {   /* whole (probes.h): the frames failed */
+			worker_say("%s: no frames for this result.h5: %s", j->tag, why);
+			f->pending = 1;
+			return PROBES_DONE;
+		}
 		worker_say("%s: no probes.json for this result.h5: %s", j->tag, why);
 		if (note)
 			snprintf(note, note_size, "no probes.json: %s", why);
@@ -296,6 +321,10 @@ static void checkpoint_uploads(struct job *j, double now)
 		return;
 	if (j->up_probes.pending && upload(j, JOB_PROBES_NAME, &j->up_probes) != SEND_OK)
 		return;
+	if (j->up_frames_bin.pending && upload(j, JOB_FRAMES_BIN, &j->up_frames_bin) != SEND_OK)
+		return;
+	if (j->up_frames_index.pending && upload(j, JOB_FRAMES_INDEX, &j->up_frames_index) != SEND_OK)
+		return;
 	if (j->up_checkpoint.pending && upload(j, "checkpoint.h5", &j->up_checkpoint) == SEND_OK)
 		worker_say("%s: checkpoint uploaded", j->tag);
 }
@@ -305,6 +334,24 @@ static void heartbeat_if_due(struct job *j, double now)
 	if (now >= j->next_heartbeat_at && backoff_due(&j->hb_b, now)) {
 		if (send_heartbeat(j) != SEND_RETRY)
 			j->next_heartbeat_at = now + j->heartbeat_every;
+	}
+}
+
+/* The worker's allocation ends soon (worker_retire_due): the solver is asked for a checkpoint of
+ * its current step and to stop (SIGUSR1), so the job goes back to the queue as an infrastructure
+ * failure and another worker resumes it from that checkpoint. A solver still running at half the
+ * margin is stopped without one (the last periodic checkpoint stands). */
+static void retire_if_due(struct job *j, double now)
+{
+	if (!j->running || !worker_retire_due(now, 1.0))
+		return;
+	if (j->stop == STOP_NONE) {
+		worker_say("%s: the allocation ends in %.0f s: checkpointing the job and handing it back", j->tag,
+			   worker_opt.end_at - now);
+		j->stop = STOP_RETIRE;
+		child_signal(j->pid, SIGUSR1);
+	} else if (j->stop == STOP_RETIRE && worker_retire_due(now, 0.5)) {
+		terminate(j, now);
 	}
 }
 
@@ -320,6 +367,7 @@ static void supervise(struct job *j)
 			j->stop = STOP_SHUTDOWN;
 			terminate(j, now);
 		}
+		retire_if_due(j, now);
 		if (j->running && j->wall_time > 0 && now - j->started >= (double)j->wall_time && j->stop == STOP_NONE) {
 			worker_say("%s: wall time of %ld s reached, terminating the solver", j->tag, j->wall_time);
 			j->stop = STOP_WALL;
@@ -374,6 +422,10 @@ static const char *outcome(struct job *j, char *message, size_t size, int *exit_
 		return "failed";
 	case STOP_SHUTDOWN:
 		snprintf(message, size, "worker '%s' was stopped while the job ran", worker_opt.name);
+		return "infrastructure";
+	case STOP_RETIRE:
+		snprintf(message, size, "handed back with a checkpoint: the allocation of worker '%s' was about to end",
+			 worker_opt.name);
 		return "infrastructure";
 	default:
 		break;
@@ -480,6 +532,8 @@ static void upload_final(struct job *j, const char *name, struct staged *f, doub
 		snprintf(j->probes_note, sizeof j->probes_note, "no probes.json: %s", text);
 		return;
 	}
+	if (!strcmp(name, JOB_FRAMES_BIN) || !strcmp(name, JOB_FRAMES_INDEX))
+		return;   /* the dashboard's frames: derived, like the probes; said in the worker's line above */
 	j->keep = 1;
 	if (!j->problem[0]) {
 		snprintf(j->problem, sizeof j->problem, "%s", text);
@@ -506,17 +560,22 @@ static int final_probes(struct job *j, struct staged *f, double deadline)
 static void final_uploads(struct job *j, double deadline)
 {
 	/* declared[] has room for each of them */
-	static const char *const names[JOB_ARTIFACTS_MAX] = {"result.h5", JOB_PROBES_NAME, "result.xdmf",
+	static const char *const names[JOB_ARTIFACTS_MAX] = {"result.h5", JOB_PROBES_NAME, JOB_FRAMES_BIN,
+							     JOB_FRAMES_INDEX, "metrics.json", "result.xdmf",
 							     "checkpoint.h5"};
 	/* a checkpoint announced but not yet sent goes first, as during the run */
 	while ((j->up_result.pending || j->up_checkpoint.pending) && wait_retry(j, &j->up_b, deadline))
 		checkpoint_uploads(j, worker_now());
 	probes_stop(&j->probes);   /* the final result supersedes a snapshot's extraction */
-	j->up_probes.pending = 0;
+	j->up_probes.pending = j->up_frames_bin.pending = j->up_frames_index.pending = 0;
 	for (size_t i = 0; i < sizeof names / sizeof *names && j->stop != STOP_LOST; i++) {
 		struct staged f = {0};
 		if (!strcmp(names[i], JOB_PROBES_NAME)) {
 			if (final_probes(j, &f, deadline) < 0)
+				continue;
+		} else if (!strcmp(names[i], JOB_FRAMES_BIN) || !strcmp(names[i], JOB_FRAMES_INDEX)) {
+			f = i == 2 ? j->up_frames_bin : j->up_frames_index;   /* staged with the probes */
+			if (!f.pending)
 				continue;
 		} else if (stage(j, names[i], &f, 0) < 0) {
 			if (i == 0)
@@ -674,6 +733,27 @@ static int prepare(struct job *j, const json_t *claim, char *err, size_t err_siz
 	return 0;
 }
 
+/* An exclusive job starts its solver only when no other job of this worker runs, any other job
+ * only when no exclusive job runs or waits (slot_try_start, docs/benchmarks.md "Exclusive
+ * jobs"); meanwhile the lease is renewed. 0 when it may start, -1 with err when the worker stops
+ * or the lease is lost first. */
+static int wait_turn(struct job *j, int exclusive, char *err, size_t err_size)
+{
+	int said = 0;
+	while (!slot_try_start(exclusive)) {
+		if (atomic_load(&worker_stopping) || j->stop == STOP_LOST) {
+			snprintf(err, err_size, "the worker stopped before the job's turn to run came");
+			return -1;
+		}
+		if (!said++)
+			worker_say("%s: waits to start: %s", j->tag, exclusive ? "an exclusive job runs alone, and other "
+				   "jobs of this worker are running" : "an exclusive job runs, or waits to run alone");
+		heartbeat_if_due(j, worker_now());
+		usleep(50000);
+	}
+	return 0;
+}
+
 /* Downloads the checkpoint of an earlier attempt; 0, or -1 with err. */
 static int fetch_checkpoint(struct job *j, const json_t *checkpoint, char *err, size_t err_size)
 {
@@ -743,7 +823,7 @@ static int start_solver(struct job *j, int resume, char *err, size_t err_size)
 	return 0;
 }
 
-void job_run(struct http_client *c, const json_t *claim)
+int job_run(struct http_client *c, const json_t *claim)
 {
 	struct job j = {0};
 	char err[10000];
@@ -752,12 +832,16 @@ void job_run(struct http_client *c, const json_t *claim)
 	j.chunk = malloc(WORKER_LOG_CHUNK);
 	int prepared = prepare(&j, claim, err, sizeof err) == 0 && j.chunk;
 	const json_t *checkpoint = json_object_get(claim, "checkpoint");
-	int resume = json_is_object(checkpoint);
-	worker_say("%s: claimed (%d thread%s, wall time %ld s%s)", j.tag, j.threads, j.threads == 1 ? "" : "s",
-		   j.wall_time, resume ? ", from a checkpoint" : "");
-	int started = 0;
+	int resume = json_is_object(checkpoint), exclusive = json_is_true(json_object_get(claim, "exclusive"));
+	worker_say("%s: claimed (%d thread%s, wall time %ld s%s%s)", j.tag, j.threads, j.threads == 1 ? "" : "s",
+		   j.wall_time, resume ? ", from a checkpoint" : "", exclusive ? ", exclusive" : "");
+	int started = 0, turn = 0;
 	if (prepared && resume && fetch_checkpoint(&j, checkpoint, err, sizeof err) < 0)
 		prepared = 0;
+	if (prepared) {
+		turn = wait_turn(&j, exclusive, err, sizeof err) == 0;
+		prepared = turn;
+	}
 	if (prepared && start_solver(&j, resume, err, sizeof err) == 0)
 		started = 1;
 	double deadline;
@@ -792,4 +876,5 @@ void job_run(struct http_client *c, const json_t *claim)
 	 * file of the attempt is not on the server: then it is the only copy */
 	if (!worker_opt.keep_work && !j.keep)
 		job_files_remove_tree(j.dir);
+	return turn;
 }

@@ -14,9 +14,10 @@
 
 #include "http_client.h"
 
-/* Runs the job of a claim answer ({"id", "attempt", "case", ...}) to its end with c, which must not
- * abort on drain. Returns when the job is finished or abandoned and its directory is removed (or
- * kept: --keep-work, or files the server does not hold). */
-void job_run(struct http_client *c, const json_t *claim);
+/* Runs the job of a claim answer ({"id", "attempt", "case", "exclusive", ...}) to its end with c,
+ * which must not abort on drain. Returns when the job is finished or abandoned and its directory is
+ * removed (or kept: --keep-work, or files the server does not hold): 1 when the job had its turn
+ * to start (slot_try_start said yes; the caller then calls slot_finished), 0 when it never got one. */
+int job_run(struct http_client *c, const json_t *claim);
 
 #endif

@@ -82,6 +82,19 @@ double worker_now(void)
 	return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
 }
 
+int worker_retire_due(double now, double fraction)
+{
+	return worker_opt.end_at > 0 && now >= worker_opt.end_at - fraction * (double)worker_opt.retire_margin;
+}
+
+long worker_seconds_left(double now)
+{
+	if (worker_opt.end_at <= 0)
+		return -1;
+	double left = worker_opt.end_at - (double)worker_opt.retire_margin - now;
+	return left > 0 ? (long)left : 0;
+}
+
 void worker_sleep(double seconds, int wake_on_drain)
 {
 	double end = worker_now() + seconds;
@@ -107,6 +120,11 @@ enum {
 	OPT_LEASE_RENEW,
 	OPT_NAME,
 	OPT_KEEP_WORK,
+	OPT_CA_FILE,
+	OPT_ALLOW_PLAIN_HTTP,
+	OPT_LIFETIME,
+	OPT_RETIRE_MARGIN,
+	OPT_IDLE_EXIT,
 	OPT_VERSION
 };
 static const struct option OPTIONS[] = {
@@ -122,6 +140,11 @@ static const struct option OPTIONS[] = {
 	{ "lease-renew", required_argument, NULL, OPT_LEASE_RENEW },
 	{ "name", required_argument, NULL, OPT_NAME },
 	{ "keep-work", required_argument, NULL, OPT_KEEP_WORK },
+	{ "ca-file", required_argument, NULL, OPT_CA_FILE },
+	{ "allow-plain-http", no_argument, NULL, OPT_ALLOW_PLAIN_HTTP },
+	{ "lifetime", required_argument, NULL, OPT_LIFETIME },
+	{ "retire-margin", required_argument, NULL, OPT_RETIRE_MARGIN },
+	{ "idle-exit", required_argument, NULL, OPT_IDLE_EXIT },
 	{ "help", no_argument, NULL, 'h' },
 	{ "version", no_argument, NULL, OPT_VERSION },
 	{ NULL, 0, NULL, 0 },
@@ -147,6 +170,16 @@ static void help(void)
 	       "  --lease-renew=S          heartbeat every S seconds (default: a third of the lease, at most 1 s)\n"
 	       "  --name=NAME              the worker's id in claims, heartbeats and metrics (default HOST:PID)\n"
 	       "  --keep-work=yes|no       keep each job's directory after the job (default no)\n"
+	       "  --ca-file=FILE           PEM certificate authorities to verify an https server against\n"
+	       "                           (default: $PORO_CA_FILE, else the system's)\n"
+	       "  --allow-plain-http       allow an http:// server that is not on loopback: the token crosses\n"
+	       "                           the network in clear text (default: refused)\n"
+	       "  --lifetime=S             the worker's allocation ends S seconds from its start (a Slurm\n"
+	       "                           pilot's time limit): it claims only jobs whose wall time fits\n"
+	       "                           what is left, and hands running jobs back with a checkpoint\n"
+	       "                           --retire-margin seconds before the end (default: no end)\n"
+	       "  --retire-margin=S        (default 60)\n"
+	       "  --idle-exit=S            exit after S seconds without a job; 0 = never (default 0)\n"
 	       "  -h, --help               this text\n"
 	       "  --version                print the version\n\n"
 	       "SIGTERM or SIGINT drains (no new jobs; running ones finish); a second one stops the solvers and\n"
@@ -308,7 +341,10 @@ static int int_option(const char *name, const char *value, long lo, long hi, lon
 
 static int parse_flags(int argc, char **argv)
 {
-	const char *solver = NULL, *work = "var/work", *name = NULL, *token_file = NULL;
+	const char *solver = NULL, *work = "var/work", *name = NULL, *token_file = NULL, *ca_file = NULL;
+	int allow_plain = 0;
+	long lifetime = 0;
+	worker_opt.retire_margin = WORKER_RETIRE_MARGIN;
 	long v, budget = 0;
 	int rc = 0, opt, index = 0;
 	worker_opt.slots = 1;
@@ -345,6 +381,11 @@ static int parse_flags(int argc, char **argv)
 				rc = bad_usage("--keep-work must be yes or no, got '%s'", optarg);
 			worker_opt.keep_work = !strcmp(optarg, "yes");
 			break;
+		case OPT_CA_FILE: ca_file = optarg; break;
+		case OPT_ALLOW_PLAIN_HTTP: allow_plain = 1; break;
+		case OPT_LIFETIME: rc = int_option(o, optarg, 1, 1L << 30, &lifetime); break;
+		case OPT_RETIRE_MARGIN: rc = int_option(o, optarg, 1, 1L << 30, &worker_opt.retire_margin); break;
+		case OPT_IDLE_EXIT: rc = int_option(o, optarg, 0, 1L << 30, &worker_opt.idle_exit); break;
 		case 'h': help(); exit(0);
 		case OPT_VERSION: printf("poro-worker %s\n", PORO_VERSION); exit(0);
 		case ':': rc = bad_usage("option '%s' needs a value", argv[optind - 1]); break;
@@ -353,6 +394,11 @@ static int parse_flags(int argc, char **argv)
 	}
 	if (rc)
 		return rc;
+	if (lifetime > 0 && lifetime <= worker_opt.retire_margin)
+		return bad_usage("--lifetime (%ld s) must be longer than --retire-margin (%ld s)", lifetime,
+				 worker_opt.retire_margin);
+	if (lifetime > 0)
+		worker_opt.end_at = worker_now() + (double)lifetime;
 	if (optind < argc)
 		return bad_usage("unexpected argument '%s'", argv[optind]);
 	if (token_file && worker_opt.token[0]) {
@@ -362,7 +408,8 @@ static int parse_flags(int argc, char **argv)
 	if (token_file && read_token_file(token_file, worker_opt.token, sizeof worker_opt.token) != 0)
 		return 2;
 	char err[1200] = "";
-	struct client_config cfg = {0};
+	struct client_config cfg = { .allow_plain_http = allow_plain };
+	snprintf(cfg.ca_file, sizeof cfg.ca_file, "%s", ca_file ? ca_file : "");
 	snprintf(cfg.server, sizeof cfg.server, "%s", worker_opt.server);
 	snprintf(cfg.token, sizeof cfg.token, "%s", worker_opt.token);
 	if (client_config_load(&cfg, err, sizeof err) < 0) {
@@ -376,6 +423,11 @@ static int parse_flags(int argc, char **argv)
 		fprintf(stderr, "poro-worker: no server URL or token (--server/--token, PORO_SERVER/PORO_TOKEN)\n");
 		return 2;
 	}
+	if (client_config_check_server(&cfg, err, sizeof err) != 0) {
+		fprintf(stderr, "poro-worker: %s\n", err);
+		return 2;
+	}
+	snprintf(worker_opt.ca_file, sizeof worker_opt.ca_file, "%s", cfg.ca_file);
 	if (find_solver(solver, worker_opt.solver, sizeof worker_opt.solver) < 0) {
 		fprintf(stderr, "poro-worker: cannot find an executable poro-solve%s%s\n", solver ? " at " : "",
 			solver ? solver : "");
@@ -439,6 +491,7 @@ int main(int argc, char **argv)
 		fprintf(stderr, "poro-worker: cannot initialise libcurl\n");
 		return 1;
 	}
+	http_global_ca_file(worker_opt.ca_file);
 	signal(SIGPIPE, SIG_IGN);
 	sigset_t set;
 	sigemptyset(&set);

@@ -67,11 +67,19 @@ int probes_start(struct probes_run *p, const char *dir, const char *result, long
 	probes_stop(p);
 	p->message_len = 0;
 	p->message[0] = '\0';
+	/* what an earlier extraction left must not pass for this one's (probes_poll's callers stage
+	 * what is there after a failure too) */
+	static const char *const outputs[] = { PROBES_OUT, PROBES_FRAMES_BIN, PROBES_FRAMES_INDEX };
+	for (size_t i = 0; i < sizeof outputs / sizeof *outputs; i++) {
+		char path[4400];
+		snprintf(path, sizeof path, "%s/%s", dir, outputs[i]);
+		unlink(path);
+	}
 	char job[32], attempt_text[32];
 	snprintf(job, sizeof job, "%lld", id);
 	snprintf(attempt_text, sizeof attempt_text, "%d", attempt);
 	char *argv[] = { worker_opt.solver, "probes", (char *)result, "--job", job, "--attempt", attempt_text, "--out",
-			 PROBES_OUT, NULL };
+			 PROBES_OUT, "--frames", PROBES_FRAMES_DIR, NULL };
 	struct child_spec spec = { .dir = dir, .argv = argv, .memory_limit_mb = worker_opt.memory_limit_mb, .threads = 1,
 				   .secret = worker_opt.token };
 	int fd;

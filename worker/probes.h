@@ -14,13 +14,18 @@
 #include <stddef.h>
 #include <sys/types.h>
 
-/* Wall time one extraction may take, seconds; it reads only the probe datasets, which take well
- * under a second even for long runs. */
+/* Wall time one extraction may take, seconds. The probe datasets take well under a second even
+ * for long runs; the frames, written after them, take longer for large runs, and a time-out
+ * there costs only the frames (the probes are already whole on disk). */
 #define PROBES_SECONDS 60.0
 /* What the child printed (its error message) that is kept, bytes. */
 #define PROBES_MESSAGE_MAX 512
-/* The file it writes, relative to the job directory. */
+/* The files it writes, relative to the job directory: the probes, and the frames in the
+ * dashboard's compact form with their index (poro-solve probes --frames upload). */
 #define PROBES_OUT "upload/probes.json"
+#define PROBES_FRAMES_DIR "upload"
+#define PROBES_FRAMES_BIN "upload/frames.bin"
+#define PROBES_FRAMES_INDEX "upload/frames.json"
 
 struct probes_run {
 	pid_t pid;                          /* the running child, 0 for none */
@@ -35,7 +40,10 @@ enum probes_state { PROBES_NONE, PROBES_RUNNING, PROBES_DONE, PROBES_FAILED };
 /* A run with nothing started; probes_stop() releases it. */
 void probes_init(struct probes_run *p);
 
-/* Starts `poro-solve probes RESULT --job ID --attempt N --out upload/probes.json` in dir, result
+/* Starts `poro-solve probes RESULT --job ID --attempt N --out upload/probes.json --frames upload`
+ * in dir, after removing what an earlier extraction wrote there. probes.json appears only whole
+ * (written and renamed), before the frames are written: when the child fails or is killed later,
+ * a probes.json present is this extraction's and complete, and only the frames are lost., result
  * being relative to dir; an extraction still running is stopped first. 0, or -1 with err. */
 int probes_start(struct probes_run *p, const char *dir, const char *result, long long id, int attempt, char *err,
 		 size_t err_size);

@@ -32,6 +32,9 @@
  * seconds; and the shorter limit after a second SIGTERM. */
 #define WORKER_FINISH_PATIENCE 300.0
 #define WORKER_STOP_PATIENCE 10.0
+/* Default --retire-margin, seconds: time for a checkpoint, its upload and the finish before the
+ * allocation ends (a large run's checkpoint may take tens of seconds to write and send). */
+#define WORKER_RETIRE_MARGIN 60
 
 /* Default memory limit of a solver: this fraction of physical memory, divided among the slots.
  * The rest is left to the worker, the page cache and whatever else the machine runs; a solver
@@ -42,6 +45,7 @@
 struct worker_options {
 	char server[1024];       /* base URL */
 	char token[512];         /* worker token */
+	char ca_file[1024];      /* PEM certificate authorities for an https server, "" for the system's */
 	int slots;               /* jobs run at once */
 	char work[4096];         /* absolute directory holding job-<id>-<attempt>/ */
 	char solver[4096];       /* absolute path of poro-solve */
@@ -57,6 +61,9 @@ struct worker_options {
 	int threads;             /* threads each slot offers in its claims and gives a solver at most:
 				  * max(1, thread_budget / slots) */
 	char solver_version[128];
+	double end_at;           /* worker_now() at which the allocation ends (--lifetime), 0: never */
+	long retire_margin;      /* seconds before end_at at which running jobs are handed back */
+	long idle_exit;          /* a slot that has had no job this many seconds ends, 0: never */
 };
 
 extern struct worker_options worker_opt;
@@ -74,7 +81,20 @@ double worker_now(void);
  * worker_draining is set and wake_on_drain is non-zero. */
 void worker_sleep(double seconds, int wake_on_drain);
 
+/* With --lifetime: 1 once fewer than fraction * retire_margin seconds are left of the allocation
+ * (1.0: time to hand running jobs back and claim no more). 0 without a lifetime. */
+int worker_retire_due(double now, double fraction);
+/* Seconds of the allocation a new job may still use (until end_at - retire_margin), at least 0;
+ * -1 without --lifetime. */
+long worker_seconds_left(double now);
+
 /* The claim loop of one slot; arg is the slot's index cast to a pointer. */
 void *slot_main(void *arg);
+
+/* Exclusive jobs (slot.c; docs/benchmarks.md "Exclusive jobs"): 1 when a claimed job may start
+ * its solver now, and then it counts as running: an exclusive job when no other job runs, any
+ * other job when no exclusive job runs or waits. slot_finished(exclusive) when it has ended. */
+int slot_try_start(int exclusive);
+void slot_finished(int exclusive);
 
 #endif

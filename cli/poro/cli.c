@@ -121,7 +121,12 @@ int cli_connect(void)
 		fprintf(stderr, "poro: no server: set PORO_SERVER or 'server = URL' in ~/.config/poro/config\n");
 		return PORO_EXIT_USAGE;
 	}
+	if (client_config_check_server(&config, err, sizeof err) != 0) {
+		fprintf(stderr, "poro: %s\n", err);
+		return PORO_EXIT_USAGE;
+	}
 	curl_ready = http_global_init() == 0;
+	http_global_ca_file(config.ca_file);
 	if (!curl_ready || !(cli_http = http_client_create(config.server, config.token))) {
 		fprintf(stderr, "poro: cannot initialise the HTTP client\n");
 		return PORO_EXIT_ERROR;

@@ -32,7 +32,9 @@
 	X(INVALID_CASE,  6, "the case file cannot be read, or the server refused the case or a setting of " \
 			    "the submission (every problem listed as JSON-pointer: message)")              \
 	X(JOB_FAILED,    7, "the job failed (submit --wait, wait, logs -f)")                                \
-	X(JOB_CANCELLED, 8, "the job was cancelled (submit --wait, wait, logs -f)")
+	X(JOB_CANCELLED, 8, "the job was cancelled (submit --wait, wait, logs -f)")                           \
+	X(REGRESSED,     9, "a benchmark run found a figure that regressed, failed or did not run (nightly "  \
+			    "run, nightly show)")
 
 enum poro_exit {
 #define PORO_EXIT_ENUM(name, status, meaning) PORO_EXIT_##name = status,
@@ -119,6 +121,7 @@ int cmd_rm(const struct subcommand *self, int argc, char **argv);
 int cmd_logs(const struct subcommand *self, int argc, char **argv);
 int cmd_fetch(const struct subcommand *self, int argc, char **argv);
 int cmd_token(const struct subcommand *self, int argc, char **argv);
+int cmd_nightly(const struct subcommand *self, int argc, char **argv);   /* nightly.c */
 
 /* Follows job id until it ends (wait.c): a progress bar on stderr when stdout and stderr are
  * terminals, else a line per state change and per tenth of progress; with json the final job on

@@ -324,6 +324,8 @@ struct case_spec {
 	struct {
 		double interval;          /* s of simulated time between checkpoints; 0 = none (key absent) */
 	} checkpoint;
+	unsigned metrics;                 /* bit (1u << k) per figure k (figures.h) the optional "metrics"
+					     object asks the run to report (case_metrics.h) */
 	char *json;                       /* the case as given, NUL-terminated */
 };
 

@@ -32,6 +32,7 @@
 #include <string.h>
 
 #include "case_json.h"
+#include "case_metrics.h"
 #include "case_formulation.h"
 #include "case_material.h"
 #include "case_region.h"
@@ -74,7 +75,7 @@ static const char *const component_names[] = { "x", "y", NULL };
 /* Keys allowed in each object. */
 static const char *const top_keys[] = { "$schema", "schema", "title", "formulation", "grid", "materials", "bodies",
 					"fluid", "gravity", "boundaries", "loads", "time", "output",
-					"probes", "checkpoint", NULL };
+					"probes", "checkpoint", "metrics", NULL };
 static const char *const grid_keys[] = { "origin", "extent", "cell_size", NULL };
 /* A material's own keys; its model's keys are checked by case_read_material_model(). */
 static const char *const material_keys[] = { "name", "density", NULL };
@@ -702,6 +703,9 @@ static void read_case(struct case_reader *r, const json_t *root, struct case_spe
 	read_output(r, root, c, time_ok);
 	read_probes(r, root, c, grid_ok);
 	read_checkpoint(r, root, c, time_ok);
+	case_read_metrics(r, root, &c->metrics);
+	if (!r->problem_count)
+		case_check_metrics(r, c);
 	if (!r->problem_count && time_ok)
 		check_stable_dt(r, c);
 }

@@ -59,7 +59,7 @@ static double lateral_slope(const struct material *m, const struct point *pt)
  * would not do: on an edge of the Mohr-Coulomb hexagon, where triaxial compression lies, the
  * lateral block of the tangent is singular because the two lateral stresses move together.) */
 static enum poro_status drained_step(const struct material *m, const struct element_case *c, const struct point *from,
-				     double dE, struct point *to, double d[2], struct poro_error *err)
+				     double dE, struct point *to, double d[2], long *newton, struct poro_error *err)
 {
 	const double *C = from->tangent, pc = c->confining_pressure;
 	/* Eqs. 108 / 110, the y and z rows averaged */
@@ -71,8 +71,10 @@ static enum poro_status drained_step(const struct material *m, const struct elem
 			return st;
 		double r = 0.5 * (to->stress[1] + to->stress[3]) + pc;
 		double scale = pc + fabs(to->stress[0]) + fabs(to->stress[1]) + fabs(to->stress[3]);
-		if (fabs(r) <= ELEMENT_STRESS_TOLERANCE * scale)
+		if (fabs(r) <= ELEMENT_STRESS_TOLERANCE * scale) {
+			*newton += it;   /* corrections taken; the predictor alone counts none */
 			return PORO_OK;
+		}
 		double slope = lateral_slope(m, to);
 		if (it == ELEMENT_ITERATIONS_MAX || !(fabs(slope) > 0))
 			return poro_error_set(err, PORO_ESOLVER, "element: lateral stress not held at the confining "
@@ -120,7 +122,8 @@ enum poro_status element_run(const struct element_case *c, struct element_result
 	double dE = c->axial_strain / c->steps, volumetric = 0;
 	for (int k = 1; k <= c->steps; k++) {
 		double d[2] = { -dE / 2, -dE / 2 };  /* undrained: Eqs. 99, 106 */
-		st = c->test == ELEMENT_DRAINED ? drained_step(&m, c, &a, dE, &b, d, err) : take_step(&m, &a, dE, d, &b, err);
+		st = c->test == ELEMENT_DRAINED ? drained_step(&m, c, &a, dE, &b, d, &r->newton_iterations, err)
+						 : take_step(&m, &a, dE, d, &b, err);
 		if (st)
 			return st;
 		a = b;

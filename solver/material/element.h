@@ -40,6 +40,7 @@ struct element_case {
 					     (finite, |ln(l / l0)| < ELEMENT_LOG_STRAIN_MAX); non-zero;
 					     negative = compression */
 	int steps;                        /* equal axial increments, 1 to ELEMENT_STEPS_MAX */
+	unsigned metrics;                 /* figures asked for by "metrics" (case_metrics.h) */
 };
 #define ELEMENT_STEPS_MAX 1000000
 #define ELEMENT_LOG_STRAIN_MAX 5.0
@@ -67,6 +68,7 @@ struct element_row {
 
 struct element_result {
 	int rows;                         /* steps + 1 */
+	long newton_iterations;           /* drained: Newton iterations over all steps (0 undrained) */
 	struct element_row *row;
 	int output_count;
 	const char *output_names[MATERIAL_OUTPUTS_MAX];

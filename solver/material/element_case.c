@@ -7,13 +7,14 @@
 #include <string.h>
 
 #include "case_json.h"
+#include "case_metrics.h"
 #include "case_material.h"
 #include "element.h"
 
 static const char *const schema_names[] = { ELEMENT_SCHEMA_VERSION, NULL };
 static const char *const test_names[] = { "drained", "undrained", NULL };
 static const char *const top_keys[] = { "$schema", "schema", "title", "material", "test", "confining_pressure",
-					"axial_strain", "steps", NULL };
+					"axial_strain", "steps", "metrics", NULL };
 
 static const struct case_range NON_NEGATIVE = { BOUND_CLOSED, 0, BOUND_NONE, 0 };
 static const struct case_range STRAIN = { BOUND_OPEN, -1, BOUND_OPEN, 1 };
@@ -41,6 +42,9 @@ static void read_element(struct case_reader *r, const json_t *root, struct eleme
 	    c->axial_strain == 0)
 		case_problem(r, "/axial_strain", "must not be 0");
 	case_read_int(r, root, "", "steps", CASE_REQUIRED, 1, ELEMENT_STEPS_MAX, &c->steps);
+	case_read_metrics(r, root, &c->metrics);
+	if (!r->problem_count)
+		case_check_element_metrics(r, c);
 }
 
 enum poro_status element_case_load_string(const char *json, struct element_case *c, struct poro_error *err)

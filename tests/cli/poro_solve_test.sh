@@ -160,7 +160,9 @@ rc=$?
 echo "$version" | grep -Eqx "poro-solve [A-Za-z0-9._-]+" && [ "$version" = "$("$solve" version)" ] && [ "$version" != "poro-solve unknown" ]
 check version_exits_0_with_the_build_version $(( rc != 0 || $? != 0 )) "exit $rc: '$version'"
 ok=0
-for c in run validate element report probes version; do
+commands=$("$solve" --help | sed -n 's/^\(usage:\|      \) poro-solve \([a-z]\+\).*/\2/p')
+[ "$(echo "$commands" | wc -l)" -ge 7 ] || ok=1   # run validate element report probes frames version
+for c in $commands; do
 	"$solve" "$c" --help > "$tmp/help" 2>&1 && grep -q "^usage: poro-solve $c" "$tmp/help" || ok=1
 done
 check every_command_help_exits_0 $ok "$(head -c 300 "$tmp/help")"

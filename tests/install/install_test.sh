@@ -2,7 +2,8 @@
 # install_test.sh - `make install DESTDIR=$tmp PREFIX=/usr` and `make uninstall` (docs/service.md §9).
 #
 # Installs into a temporary root and checks: exactly the expected files, with their modes (the
-# five programs; the two systemd units with their paths filled in; the sysusers.d account; the
+# five programs; the four systemd units (server, worker, the benchmark nightly's service and
+# timer) with their paths filled in; the sysusers.d account; the
 # schemas; the five man pages with the version set; the bash completions of poro and poro-solve;
 # the configuration); the installed programs run; every man page renders with `man -l` without a
 # warning, and the poro-server and poro-worker pages name every option their --help lists; each
@@ -39,6 +40,8 @@ cat > "$tmp/want.txt" <<'EOF'
 755 usr/bin/poro-server
 755 usr/bin/poro-solve
 755 usr/bin/poro-worker
+644 usr/lib/systemd/system/poro-nightly.service
+644 usr/lib/systemd/system/poro-nightly.timer
 644 usr/lib/systemd/system/poro-server.service
 644 usr/lib/systemd/system/poro-worker@.service
 644 usr/lib/sysusers.d/poro.conf
@@ -53,10 +56,12 @@ cat > "$tmp/want.txt" <<'EOF'
 644 usr/share/poro/examples/worker.env
 644 usr/share/poro/schemas/case.schema.json
 644 usr/share/poro/schemas/element.schema.json
+644 usr/share/poro/schemas/metrics.schema.json
 644 usr/share/poro/schemas/openapi.yaml
 644 usr/share/poro/schemas/results.md
+644 usr/share/poro/schemas/suite.schema.json
 EOF
-[ -d web ] && (cd web && find . -type f | sed 's|^\./|644 usr/share/poro/web/|') >> "$tmp/want.txt"
+[ -d web ] && (cd web && find -L . -type f | sed 's|^\./|644 usr/share/poro/web/|') >> "$tmp/want.txt"
 # every file, and the directories of etc/ (an installed directory of its own there)
 (cd "$root" && { find . -type f; find ./etc -mindepth 1 -type d; } | sed 's|^\./||' | sort |
 	while read -r f; do echo "$(stat -c %a "$f") $f"; done) > "$tmp/got.txt"
@@ -72,6 +77,7 @@ check installed_programs_run $? "$(cat "$tmp/v.txt")"
 units="$root/usr/lib/systemd/system"
 grep -q '^ExecStart=/usr/bin/poro-server --config=/etc/poro/poro-server.conf ' "$units/poro-server.service" &&
 	grep -q '^ExecStart=/usr/bin/poro-worker .*--solver=/usr/bin/poro-solve' "$units/poro-worker@.service" &&
+	grep -q '^ExecStart=/usr/bin/poro nightly run ' "$units/poro-nightly.service" &&
 	! grep -q '@[a-z]*@' "$units"/*.service
 check units_name_the_installed_programs $? "$(grep -h '^ExecStart\|@[a-z]*@' "$units"/*.service)"
 
@@ -126,6 +132,12 @@ check completion_poro_completes $? "su -> '$(complete_words "$comp/poro" _poro p
 	[ "$(complete_words "$comp/poro-solve" _poro_solve poro-solve run case.json --ou)" = --out ] &&
 	[ "$(complete_words "$comp/poro-solve" _poro_solve poro-solve probes r.h5 --at)" = --attempt ]
 check completion_poro_solve_completes $? "val -> '$(complete_words "$comp/poro-solve" _poro_solve poro-solve val)'"
+# the completion offers exactly the commands poro-solve's own usage lists, so a new command cannot
+# be left out of it
+commands=$("$root/usr/bin/poro-solve" --help | sed -n 's/^\(usage:\|      \) poro-solve \([a-z]\+\).*/\2/p' | sort | tr '\n' ' ')
+offered=$(complete_words "$comp/poro-solve" _poro_solve poro-solve '' | sort | tr '\n' ' ')
+[ -n "$commands" ] && [ "$commands" = "$offered" ]
+check completion_poro_solve_offers_every_command $? "usage lists '$commands', the completion offers '$offered'"
 
 # ---- systemd ----------------------------------------------------------------------------------------
 # The units are checked as installed: in a root holding the installation and the system's own
@@ -139,7 +151,7 @@ else
 	cp -a "$root/." "$vroot/"
 	cp -rn /usr/lib/systemd/system/. "$vroot/usr/lib/systemd/system/"
 	(cd "$tmp" && MANPATH="$root/usr/share/man" systemd-analyze verify --root="$vroot" poro-server.service \
-		poro-worker@1.service) > "$tmp/verify.txt" 2>&1
+		poro-worker@1.service poro-nightly.service poro-nightly.timer) > "$tmp/verify.txt" 2>&1
 	rc=$?
 	[ "$rc" = 0 ] && [ ! -s "$tmp/verify.txt" ]
 	check systemd_analyze_verify_installed_units $? "exit $rc: $(head -5 "$tmp/verify.txt")"
@@ -148,7 +160,7 @@ else
 	(cd "$tmp" && MANPATH="$root/usr/share/man" systemd-analyze verify --root="$vroot" poro-server.service) > /dev/null 2>&1
 	check systemd_analyze_verify_sees_a_missing_program $(( $? == 0 )) "verify passed without /usr/bin/poro-server"
 	cp "$root/usr/bin/poro-server" "$vroot/usr/bin/"
-	for unit in poro-server.service poro-worker@1.service; do
+	for unit in poro-server.service poro-worker@1.service poro-nightly.service; do
 		(cd "$tmp" && systemd-analyze security --offline=true --root="$vroot" "$unit") > "$tmp/security.txt" 2>&1
 		score=$(grep -oE 'Overall exposure level for [^:]+: [0-9.]+' "$tmp/security.txt" | grep -oE '[0-9.]+$')
 		echo "INFO systemd-analyze security --offline=true $unit: exposure $score (0 = locked down, 10 = exposed)"

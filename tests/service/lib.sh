@@ -158,8 +158,17 @@ svc_header() {
 }
 
 # check NAME CONDITION-STATUS WHY: prints "PASS NAME" when the status is 0, else "FAIL NAME: WHY".
+# svc_summary prints the closing "N passed, N failed" of the checks made so far.
+SVC_PASSED=0 SVC_FAILED=0
 check() {
-	if [ "$2" -eq 0 ]; then echo "PASS $1"; else echo "FAIL $1: $3"; fi
+	if [ "$2" -eq 0 ]; then
+		echo "PASS $1"; SVC_PASSED=$((SVC_PASSED + 1))
+	else
+		echo "FAIL $1: $3"; SVC_FAILED=$((SVC_FAILED + 1))
+	fi
+}
+svc_summary() {
+	echo "$SVC_PASSED passed, $SVC_FAILED failed"
 }
 
 # svc_asan BINARY: status 0 when BINARY was built with AddressSanitizer (make test-san), whose

@@ -9,14 +9,14 @@
  *    equation, in the initial (Lagrangian) depth z of a column of height H drained at the top,
  *        dJ/dt = d/dz [ k(J) / (rho_w g J) dp/dz ],   J = (1 + e)/(1 + e0) = exp(-m_v (q - p)),
  *    integrated explicitly on 100 cells, against Xie and Leo's closed form (000 Eqs. 87 and 90,
- *    tests/verify/analytic.h). With k = k0 J^2 the equation is linear in exp(m_v p), so the
+ *    solver/verify/analytic.h). With k = k0 J^2 the equation is linear in exp(m_v p), so the
  *    closed form must be met to the discretisation error (asserted: settlement within 0.1%,
  *    pressure RMS within 0.1% of q); with k = k0 J it is not, and the column runs ahead (asserted:
  *    more than 5% ahead at U = 0.25). The column is the Xie-Leo one of 000 §5.2 (H = 1 m,
  *    E = 1 MPa, nu = 0, q = 200 kPa, k0 = 1e-3 m/s, n0 = 0.3).
  */
 #include "../harness.h"
-#include "../verify/analytic.h"
+#include "analytic.h"
 #include "../verify/gibson.h"
 #include "permeability.h"
 

@@ -3,7 +3,7 @@
  *
  * Under a plate on a laterally confined column every horizontal section carries the same force,
  * so the column consolidates as under a uniform load: the oracle is Terzaghi's closed form
- * (tests/verify/analytic.h) with the drainage at the bottom and the plate impermeable on top.
+ * (solver/verify/analytic.h) with the drainage at the bottom and the plate impermeable on top.
  * tests/cases/terzaghi.json is run with its top traction q replaced by a plate of force q times
  * the column's width on the grid's top face (brought down to the column's top) and its bottom
  * drained:
@@ -18,7 +18,7 @@
 #include <string.h>
 
 #include "../harness.h"
-#include "../verify/analytic.h"
+#include "analytic.h"
 #include "../verify/column.h"
 #include "case.h"
 #include "poro.h"

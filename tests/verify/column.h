@@ -17,27 +17,12 @@
 #include <math.h>
 #include <stdlib.h>
 
+#include "figures.h"
 #include "poro.h"
 
 static inline double soil_reference_height(const struct sim *s, double y, double top0)
 {
-	const struct particles *p = sim_soil(s);
-	const double x_ref = p->x0[0];
-	double below_y = -1e300, below_y0 = 0, above_y = 1e300, above_y0 = top0;
-	for (idx_t q = 0; q < p->n; q++) {
-		if (fabs(p->x0[2 * q] - x_ref) > 1e-9)
-			continue;
-		double yq = p->x[2 * q + 1], y0 = p->x0[2 * q + 1];
-		if (yq <= y && yq > below_y)
-			below_y = yq, below_y0 = y0;
-		if (yq > y && yq < above_y)
-			above_y = yq, above_y0 = y0;
-	}
-	if (below_y < -1e299)
-		return above_y0 * y / above_y;
-	if (above_y > 1e299)
-		return top0;    /* above the top row: inside the drained skin */
-	return below_y0 + (above_y0 - below_y0) * (y - below_y) / (above_y - below_y);
+	return figure_reference_height(sim_soil(s), y, top0);   /* the solver's figures use the same */
 }
 
 /* Mean over the soil points of the total vertical stress, compression positive: the effective

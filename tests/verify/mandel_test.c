@@ -1,5 +1,5 @@
 /*
- * mandel_test.c - Mandel's problem against its closed form (tests/verify/analytic.h).
+ * mandel_test.c - Mandel's problem against its closed form (solver/verify/analytic.h).
  *
  * The closed form is checked first, against facts it must meet and against an independent
  * solution of the same equations. Under a rigid smooth plate the vertical strain eps(t) is uniform;

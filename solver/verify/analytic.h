@@ -1,5 +1,7 @@
 /*
- * analytic.h - closed-form consolidation solutions the verification tests compare against.
+ * analytic.h - the closed forms PoroMPM is checked against, in one place: the verification tests
+ * compare with them, and the solver's figures (figures.h: the metrics a run reports for the
+ * benchmark nightlies) are computed from them.
  *
  * Terzaghi (000 Eqs. 84-86, with the known extraction slip of Eq. 84 corrected: the exponential
  * multiplies each term of the series): excess pore pressure at depth z below the drained face,
@@ -191,6 +193,17 @@ static inline double mandel_pressure_ratio_ramped(double x, double a, double Tv,
 static inline double mandel_initial_pressure(double F, double a, double B, double nu_u)
 {
 	return B * (1.0 + nu_u) * F / (3.0 * a);
+}
+
+/* Mohr-Coulomb in drained triaxial compression at cell pressure pc (Pa, compression positive):
+ * the deviator at failure, q = (2 pc sin(phi) + 2 c cos(phi) / J) / (1 - sin(phi)) (sigma_1 =
+ * sigma_3 (1 + sin) / (1 - sin) + 2 c cos / (1 - sin), minus sigma_3), phi in radians, c in Pa;
+ * J the volume ratio at finite strain (the Kirchhoff cohesion seen as a Cauchy stress), 1 at
+ * small strain. tests/solver/element_test.c checks the driver against it. */
+static inline double mohr_coulomb_drained_peak_q(double pc, double c, double phi, double J)
+{
+	double s = sin(phi);
+	return (2.0 * pc * s + 2.0 * c * cos(phi) / J) / (1.0 - s);
 }
 
 #endif
