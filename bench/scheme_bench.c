@@ -15,14 +15,19 @@
  *    and the solves; the iterations a step; the symbolic analyses, factorisations and solves per
  *    1,000 steps (one analysis a run is the aim: the pattern is the grid's) and the factors'
  *    nonzeros. With the elastic tangent (001's modified Newton-Raphson) and the consistent one.
+ * 3. 002 §4.2's strip load to its end by each scheme at its own step (strip): wall time per
+ *    simulated second.
  * Figures are printed, never asserted; bench/run.sh runs it on one thread.
  *
- *   scheme_bench [--simulated SECONDS] [--steps N]
+ *   scheme_bench [--simulated SECONDS] [--steps N] [--only columns|strip|footing]
  */
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
+
+#include <jansson.h>
 
 #include "case.h"
 #include "poro.h"
@@ -73,6 +78,60 @@ static void column(const char *label, const char *file, double simulated)
 	const double seconds = wall() - t0, points = (double)sim_soil(s)->n + (sim_is_double_point(s) ? (double)sim_water(s)->n : 0);
 	printf("  %-14s dt %8.2e s  %6ld steps  %9.3f s wall per simulated second  %8.3f us per material-point step\n",
 	       label, c->time.dt, done, seconds / (done * c->time.dt), 1e6 * seconds / (done * points));
+	sim_destroy(&s);
+	case_destroy(&c);
+}
+
+/* The case in file with formulation.scheme set to scheme (NULL: as it is) and time.dt to dt
+ * (a number, or "auto"). */
+static struct case_spec *load_as(const char *file, const char *scheme, json_t *dt)
+{
+	json_error_t jerr;
+	struct poro_error err = {0};
+	struct case_spec *c = NULL;
+	json_t *doc = json_load_file(file, 0, &jerr);
+	if (!doc) {
+		fprintf(stderr, "scheme_bench: %s: %s\n", file, jerr.text);
+		json_decref(dt);
+		return NULL;
+	}
+	if (scheme)
+		json_object_set_new(json_object_get(doc, "formulation"), "scheme", json_string(scheme));
+	json_object_set_new(json_object_get(doc, "time"), "dt", dt);
+	char *text = json_dumps(doc, 0);
+	if (!text || case_load_string(text, &c, &err))
+		fprintf(stderr, "scheme_bench: %s as %s: %s\n", file, scheme ? scheme : "is", err.message);
+	free(text);
+	json_decref(doc);
+	return c;
+}
+
+/* 002 §4.2's strip load (0.5 m cells) to its end, 0.1 s, by one scheme at its own step: the wall
+ * time per simulated second, the figure that tells a user which scheme to pick for a run. */
+static void strip(const char *label, const char *file, const char *scheme, json_t *dt)
+{
+	struct case_spec *c = load_as(file, scheme, dt);
+	struct sim *s = c ? build(c) : NULL;
+	if (!s) {
+		case_destroy(&c);
+		return;
+	}
+	const double t0 = wall();
+	long done = 0;
+	for (; !sim_done(s); done++)
+		if (sim_step(s)) {
+			fprintf(stderr, "scheme_bench: %s: %s\n", label, sim_error(s)->message);
+			break;
+		}
+	const double seconds = wall() - t0, dt_used = sim_time(s) / (done > 0 ? done : 1);
+	const double points = (double)sim_soil(s)->n + (sim_is_double_point(s) ? (double)sim_water(s)->n : 0);
+	const struct particles *p = sim_soil(s);
+	double largest = 0.0;   /* the maximum displacement, 002's figure (6.737 mm): the step's accuracy */
+	for (idx_t q = 0; q < p->n; q++)
+		largest = fmax(largest, hypot(p->x[2 * q] - p->x0[2 * q], p->x[2 * q + 1] - p->x0[2 * q + 1]));
+	printf("  %-34s dt %8.2e s  %5ld steps  %8.3f s wall per simulated second  %8.3f us per material-point step"
+	       "  max displacement %.3f mm\n", label, dt_used, done, seconds / sim_time(s),
+	       1e6 * seconds / ((double)done * points), 1e3 * largest);
 	sim_destroy(&s);
 	case_destroy(&c);
 }
@@ -130,22 +189,37 @@ int main(int argc, char **argv)
 {
 	double simulated = 0.02;
 	int steps = 40;
+	const char *only = NULL;   /* "columns", "strip" or "footing": that part alone */
 	for (int i = 1; i < argc; i++) {
 		if (!strcmp(argv[i], "--simulated") && i + 1 < argc)
 			simulated = atof(argv[++i]);
 		else if (!strcmp(argv[i], "--steps") && i + 1 < argc)
 			steps = atoi(argv[++i]);
+		else if (!strcmp(argv[i], "--only") && i + 1 < argc)
+			only = argv[++i];
 		else {
 			fprintf(stderr, "scheme_bench: unknown argument '%s'\n", argv[i]);
 			return 2;
 		}
 	}
-	printf("Terzaghi column of 002 §4.1.1, %g s simulated, each scheme at its own step:\n", simulated);
-	column("semi_implicit", "tests/cases/terzaghi_single_point.json", simulated);
-	column("explicit", "tests/cases/terzaghi_002.json", simulated);
-	column("implicit_upU", "tests/cases/terzaghi_001.json", simulated);
-	printf("strip footing of 001 §4.1.1 (0.25 m cells), implicit_upU:\n");
-	footing("elastic tangent", NEWTON_TANGENT_ELASTIC, steps);
-	footing("consistent tangent", NEWTON_TANGENT_CONSISTENT, steps);
+	if (!only || !strcmp(only, "columns")) {
+		printf("Terzaghi column of 002 §4.1.1, %g s simulated, each scheme at its own step:\n", simulated);
+		column("semi_implicit", "tests/cases/terzaghi_single_point.json", simulated);
+		column("explicit", "tests/cases/terzaghi_002.json", simulated);
+		column("implicit_upU", "tests/cases/terzaghi_001.json", simulated);
+	}
+	if (!only || !strcmp(only, "strip")) {
+		printf("strip load of 002 §4.2 (0.5 m cells) to 0.1 s, each scheme at its own step (\"auto\": the stable step it allows;\n"
+		       "the implicit scheme has no bound: 1e-3 s):\n");
+		strip("semi_implicit, double point", "tests/cases/strip_load_002.json", NULL, json_string("auto"));
+		strip("semi_implicit, as its case, 2e-4", "tests/cases/strip_load_002.json", NULL, json_real(2e-4));
+		strip("explicit", "tests/cases/strip_load_002_explicit.json", NULL, json_string("auto"));
+		strip("implicit_upU", "tests/cases/strip_load_002_explicit.json", "implicit_upU", json_real(1e-3));
+	}
+	if (!only || !strcmp(only, "footing")) {
+		printf("strip footing of 001 §4.1.1 (0.25 m cells), implicit_upU:\n");
+		footing("elastic tangent", NEWTON_TANGENT_ELASTIC, steps);
+		footing("consistent tangent", NEWTON_TANGENT_CONSISTENT, steps);
+	}
 	return 0;
 }

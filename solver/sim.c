@@ -245,6 +245,10 @@ static enum poro_status build(struct sim *s)
 	init_soil_state(s);
 	if ((st = init_water(s, saturated)) || (st = allocate_scratch(s)))
 		return st;
+	/* the parallel scatters' order (point_blocks.h); single-point water uses the soil's */
+	if ((st = particles_add_blocks(&s->soil, &s->grid, &s->err)) ||
+	    (s->double_point && (st = particles_add_blocks(&s->water, &s->grid, &s->err))))
+		return st;
 	if (c->formulation.velocity_update != VELOCITY_UPDATE_FLIP &&
 	    ((st = particles_add_affine(&s->soil, &s->err)) || (st = particles_add_affine(&s->water, &s->err))))
 		return st;

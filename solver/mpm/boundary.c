@@ -41,6 +41,7 @@ void boundary_mark(struct sim *s)
 
 void boundary_apply(const struct grid *g, const unsigned char *fix, double *v)
 {
+	#pragma omp parallel for schedule(static)
 	for (idx_t I = 0; I < g->node_count; I++) {
 		if (fix[I] & 1)
 			v[2 * I] = 0.0;

@@ -16,9 +16,11 @@ void deformation_increment(struct sim *s, const double *du)
 	if (s->spec->formulation.position_update == POSITION_UPDATE_MUSL_DISPLACEMENT) {
 		/* 7b from the field whose gradient is dF, so volume and motion stay one (phases.h) */
 		g2p_vector(&s->grid, p, du, s->soil_grad);
+		#pragma omp parallel for schedule(static)
 		for (idx_t k = 0; k < DIM * p->n; k++)
 			p->x[k] += s->soil_grad[k];
 	}
+	#pragma omp parallel for schedule(static)
 	for (idx_t q = 0; q < p->n; q++) {
 		p->dF[4 * q] += 1.0, p->dF[4 * q + 3] += 1.0;
 	}
@@ -55,22 +57,28 @@ static enum poro_status inverted(struct sim *s, idx_t bad)
 			      s->step + 1, 1.0 - p->porosity0[bad]);
 }
 
+/* Every point is updated, in parallel; the failure reported is the lowest-numbered failing
+ * point's, as a serial loop stopping at the first would report it, at any thread count. */
 enum poro_status deformation_apply(struct sim *s)
 {
-	struct particles *p = &s->soil;
+	const struct particles *p = &s->soil;
+	idx_t bad = p->n;
+	#pragma omp parallel for schedule(static) reduction(min : bad)
 	for (idx_t q = 0; q < p->n; q++) {
 		const double *dF = p->dF + 4 * q;
 		if (!apply_point(s, q, dF[0] * dF[3] - dF[1] * dF[2]))
-			return inverted(s, q);
+			bad = q < bad ? q : bad;
 	}
-	return PORO_OK;
+	return bad < p->n ? inverted(s, bad) : PORO_OK;
 }
 
 enum poro_status deformation_apply_volumetric(struct sim *s, const double *rate)
 {
-	struct particles *p = &s->soil;
+	const struct particles *p = &s->soil;
+	idx_t bad = p->n;
+	#pragma omp parallel for schedule(static) reduction(min : bad)
 	for (idx_t q = 0; q < p->n; q++)
 		if (!apply_point(s, q, 1.0 + s->dt * rate[q]))
-			return inverted(s, q);
-	return PORO_OK;
+			bad = q < bad ? q : bad;
+	return bad < p->n ? inverted(s, bad) : PORO_OK;
 }

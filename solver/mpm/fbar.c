@@ -21,7 +21,9 @@ static idx_t patch_of(const struct sim *s, idx_t q)
 }
 
 /* Patch-wise mass average of a soil-point scalar (000 Eq. 83): every point of a patch gets
- * sum_{q in patch} m_q value_q / sum_{q in patch} m_q. */
+ * sum_{q in patch} m_q value_q / sum_{q in patch} m_q. The patch sums stay serial, in index
+ * order (the same at any thread count): two additions a point, and a patch is found from the
+ * point's position, not its node0, so the scatters' block order (point_blocks.h) does not apply. */
 static void average_patchwise(struct sim *s, const double *value, double *avg)
 {
 	const struct particles *p = &s->soil;
@@ -33,6 +35,7 @@ static void average_patchwise(struct sim *s, const double *value, double *avg)
 		s->patch_mass[k] += p->mass[q];
 		s->patch_mass_Je[k] += p->mass[q] * value[q];
 	}
+	#pragma omp parallel for schedule(static)
 	for (idx_t q = 0; q < p->n; q++) {
 		idx_t k = patch_of(s, q);   /* a point's own patch has its mass: the division is safe */
 		avg[q] = s->patch_mass_Je[k] / s->patch_mass[k];
@@ -64,11 +67,13 @@ static void apply_fbar(struct sim *s)
 {
 	struct particles *p = &s->soil;
 	double *dJ = s->soil_scalar, *dJbar = s->soil_coef;
+	#pragma omp parallel for schedule(static)
 	for (idx_t q = 0; q < p->n; q++) {
 		const double *dF = p->dF + 4 * q;
 		dJ[q] = dF[0] * dF[3] - dF[1] * dF[2];
 	}
 	point_map_average_nodewise(s, dJ, dJbar);
+	#pragma omp parallel for schedule(static)
 	for (idx_t q = 0; q < p->n; q++) {
 		if (!(dJ[q] > 0.0) || !(dJbar[q] > 0.0))
 			continue;   /* an inverted point is reported by the caller */
@@ -89,12 +94,14 @@ static void stabilise_elastic_strain(struct sim *s)
 {
 	struct particles *p = &s->soil;
 	double *Je = s->soil_scalar, *Jebar = s->soil_coef;
+	#pragma omp parallel for schedule(static)
 	for (idx_t q = 0; q < p->n; q++) {
 		const double *Be = p->Be + 4 * q;
 		double det = (Be[0] * Be[1] - Be[2] * Be[2]) * Be[3];
 		Je[q] = det > 0.0 ? sqrt(det) : 0.0;
 	}
 	average_patchwise(s, Je, Jebar);
+	#pragma omp parallel for schedule(static)
 	for (idx_t q = 0; q < p->n; q++) {
 		if (!(Je[q] > 0.0) || !(Jebar[q] > 0.0))
 			continue;   /* a degenerate Be is reported by the stress update */

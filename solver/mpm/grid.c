@@ -63,10 +63,17 @@ enum poro_status grid_fields_init(struct grid_fields *f, const struct grid *g, s
 	return PORO_OK;
 }
 
+void grid_zero(double *field, size_t count)
+{
+	#pragma omp parallel for schedule(static)
+	for (size_t i = 0; i < count; i++)
+		field[i] = 0.0;
+}
+
 void grid_fields_reset(struct grid_fields *f, const struct grid *g)
 {
 	const size_t n = (size_t)g->node_count;
-#define ZERO(name, width, reset) if (reset) memset(f->name, 0, n * (width) * sizeof(double));
+#define ZERO(name, width, reset) if (reset) grid_zero(f->name, n * (width));
 	GRID_DOUBLE_FIELDS(ZERO)
 #undef ZERO
 }

@@ -56,6 +56,11 @@ enum poro_status grid_init(struct grid *g, const struct case_grid *spec, struct 
 enum poro_status grid_fields_init(struct grid_fields *f, const struct grid *g, struct poro_error *err);
 /* Zeroes the fields a step maps into (000 §4.5 step 2: the grid carries nothing between steps). */
 void grid_fields_reset(struct grid_fields *f, const struct grid *g);
+
+/* Zeroes count doubles of a nodal array on the calling team's threads: a step clears several MB
+ * of nodal arrays and stencils, and one thread's memset leaves the other cores' share of the
+ * memory bandwidth unused. */
+void grid_zero(double *field, size_t count);
 void grid_fields_release(struct grid_fields *f);
 
 static inline idx_t grid_node(const struct grid *g, idx_t i, idx_t j)

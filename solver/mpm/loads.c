@@ -46,6 +46,7 @@
  */
 #include <math.h>
 
+#include "point_blocks.h"
 #include "shape.h"
 #include "sim_internal.h"
 
@@ -95,7 +96,10 @@ void loads_init(struct sim *s)
 	}
 }
 
-/* Load l at the midpoints of its points' faces (file comment). */
+/* Load l at the midpoints of its points' faces (file comment). Serial, in index order: a face
+ * midpoint's support is not its point's, so the block order of the parallel scatters
+ * (point_blocks.h) does not keep two threads off its nodes; the loop touches only the loaded
+ * points' nodes. */
 static void add_at_faces(struct sim *s, int l, double scale, double *force)
 {
 	const struct case_spec *c = s->spec;
@@ -137,7 +141,7 @@ static void add_through_points(struct sim *s, int l, double scale, double *force
 	const idx_t nx = s->grid.nodes[0];
 	const double sign = band->sign, face = band->face, D = band->depth;
 	const double tx = load->traction[0] * scale, ty = load->traction[1] * scale;
-	for (idx_t q = 0; q < p->n; q++) {
+	FOR_POINTS_BY_BLOCK(p, q, {   /* a scatter from the points' own supports (point_blocks.h) */
 		const double along = p->x0[2 * q + 1 - axis];
 		if (p->body[q] != load->body || along < band->along[0] || along > band->along[1])
 			continue;
@@ -157,7 +161,7 @@ static void add_through_points(struct sim *s, int l, double scale, double *force
 			force[2 * I] += tx * g;
 			force[2 * I + 1] += ty * g;
 		}
-	}
+	});
 }
 
 void loads_add_tractions(struct sim *s, double time, double *force)

@@ -4,6 +4,8 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "point_blocks.h"
+
 /* Every owned array, with its per-point width, in one table so init and release cannot drift. */
 #define PARTICLE_ARRAYS(X, skel)                                   \
 	X(x, 2, !alias) X(x0, 2, !alias) X(v, 2, 1) X(mass, 1, 1)  \
@@ -75,6 +77,12 @@ enum poro_status particles_add_affine(struct particles *p, struct poro_error *er
 	return PORO_OK;
 }
 
+enum poro_status particles_add_blocks(struct particles *p, const struct grid *g, struct poro_error *err)
+{
+	static const idx_t size[2] = {POINT_BLOCK_CELLS_X, POINT_BLOCK_CELLS_Y};
+	return p->blocks ? PORO_OK : point_blocks_create(&p->blocks, g, p->n, size, err);
+}
+
 enum poro_status particles_add_out_of_plane(struct particles *p, struct poro_error *err)
 {
 	if (!p->dF_zz && !(p->dF_zz = calloc(p->n > 0 ? (size_t)p->n : 1, sizeof(double))))
@@ -103,6 +111,8 @@ void particles_remove(struct particles *p, idx_t q)
 		p->node0[q] = p->node0[last];
 	}
 	p->n--;
+	if (p->blocks)
+		p->blocks->n = -1;
 }
 
 void particles_release(struct particles *p)
@@ -118,5 +128,6 @@ void particles_release(struct particles *p)
 	free(p->stress); free(p->F); free(p->Be); free(p->state); free(p->plastic_strain);
 	free(p->dF); free(p->dF_zz); free(p->acceleration);
 	free(p->surface); free(p->surface_load);
+	point_blocks_destroy(&p->blocks);
 	memset(p, 0, sizeof *p);
 }

@@ -26,6 +26,8 @@ typedef int32_t idx_t;            /* matches CHOLMOD's int interface */
 #define SHAPE_NODES_MAX (SHAPE_SUPPORT_MAX * SHAPE_SUPPORT_MAX)
 #define STATE_MAX 8                 /* model internal variables per point */
 
+struct point_blocks;                /* point_blocks.h */
+
 struct particles {
 	idx_t n;                    /* number of points */
 	const struct particles *alias_of; /* single-point water set: the soil set it rides on */
@@ -67,6 +69,11 @@ struct particles {
 	idx_t *node0;               /* [n] linear index of the lower-left support node */
 	double *shape;              /* [4 SHAPE_SUPPORT_MAX n] the 1-D factors of S_Ip: point q's block of
 				       4 support values at 4 support q (see particle_shape) */
+	struct point_blocks *blocks; /* the points by block of the cells that hold them, the order in
+				       which the scatters run in parallel (point_blocks.h), sorted by
+				       shape_evaluate with the cache; owned. NULL: scatters run
+				       serially in index order. An aliased set has none and uses its
+				       soil set's */
 };
 
 /* The shape functions are tensor products: for the support node a + b support (a along x, b
@@ -103,8 +110,15 @@ enum poro_status particles_add_out_of_plane(struct particles *p, struct poro_err
  * Returns PORO_ENOMEM on failure. */
 enum poro_status particles_add_implicit_state(struct particles *p, struct poro_error *err);
 
-/* Removes point q by moving the last point into its place (order is not kept). Not for aliased
- * sets or sets with skeleton arrays. */
+/* Gives p the scatter blocks of grid g for its n points, POINT_BLOCK_CELLS_X x POINT_BLOCK_CELLS_Y
+ * cells each (point_blocks.h); shape_evaluate sorts them from then on. Returns PORO_ENOMEM on
+ * failure. */
+struct grid;
+enum poro_status particles_add_blocks(struct particles *p, const struct grid *g, struct poro_error *err);
+
+/* Removes point q by moving the last point into its place (order is not kept); the scatter
+ * blocks are stale until the next shape_evaluate. Not for aliased sets or sets with skeleton
+ * arrays. */
 void particles_remove(struct particles *p, idx_t q);
 
 void particles_release(struct particles *p);

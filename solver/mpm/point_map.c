@@ -28,6 +28,7 @@ enum poro_status point_map_shapes(struct sim *s)
 /* Divides a nodal field (width 1 or 2) by a nodal weight where the weight is positive. */
 void point_map_normalise(idx_t nodes, double *field, int width, const double *weight)
 {
+	#pragma omp parallel for schedule(static)
 	for (idx_t I = 0; I < nodes; I++)
 		for (int c = 0; c < width; c++)
 			field[width * I + c] = weight[I] > 0.0 ? field[width * I + c] / weight[I] : 0.0;
@@ -103,12 +104,15 @@ void point_map_soil(struct sim *s)
 	point_map_normalise(nodes, f->conductivity, 1, f->mass_s);
 	if (s->saturated_soil < p->n)
 		conductivity_of_saturated_soil(s);
-	for (idx_t I = 0; I < nodes; I++)   /* where there is no soil the pores are all water */
-		f->porosity[I] = f->mass_s[I] > 0.0 ? f->porosity[I] / f->mass_s[I] : 1.0;
 	const double k_loading = s->spec->gravity.loading_conductivity;
-	if (k_loading > 0.0 && loads_in_gravity_ramp(s))   /* 000 §5.4: drain the loading's excess pressure */
-		for (idx_t I = 0; I < nodes; I++)
-			f->conductivity[I] = f->mass_s[I] > 0.0 ? k_loading : 0.0;
+	const int loading = k_loading > 0.0 && loads_in_gravity_ramp(s);
+	#pragma omp parallel for schedule(static)
+	for (idx_t I = 0; I < nodes; I++) {
+		const double Ms = f->mass_s[I];
+		f->porosity[I] = Ms > 0.0 ? f->porosity[I] / Ms : 1.0;   /* no soil: the pores are all water */
+		if (loading)   /* 000 §5.4: drain the loading's excess pressure */
+			f->conductivity[I] = Ms > 0.0 ? k_loading : 0.0;
+	}
 	memcpy(f->v_s_old, f->v_s, 2 * sizeof(double) * (size_t)nodes);
 }
 
@@ -132,17 +136,20 @@ void point_map_water(struct sim *s, enum nodal_pressure nodal)
 			   {w->mass, w->pressure, f->pressure}},
 		.vector = {w->mass, w->v, affine ? NULL : f->v_w},   /* the affine momentum: point_map_momentum */
 	};
-	s->mapped_mass_w = 0.0;
-	for (idx_t q = 0; q < w->n; q++) {
-		if (s->double_point) {
+	const int double_point = s->double_point;
+	const double rho_w = s->rho_w;
+	FOR_POINTS_BY_BLOCK(w, q, {
+		if (double_point) {
 			w->porosity[q] = g2p_scalar_point(&s->grid, w, q, f->porosity);
 			w->volume[q] = w->porosity0[q] / w->porosity[q] * w->volume0[q];
 		}
 		/* n rho_w V: constant n0 rho_w V0 in double point (Eq. 37) */
-		w->mass[q] = w->porosity[q] * s->rho_w * w->volume[q];
-		s->mapped_mass_w += w->mass[q];
+		w->mass[q] = w->porosity[q] * rho_w * w->volume[q];
 		p2g_batch_point(&s->grid, w, q, &b);
-	}
+	});
+	s->mapped_mass_w = 0.0;   /* in index order after the loop: the same sum at any thread count */
+	for (idx_t q = 0; q < w->n; q++)
+		s->mapped_mass_w += w->mass[q];
 	if (affine)
 		point_map_momentum(s, w, f->v_w);
 	point_map_normalise(nodes, f->v_w, 2, f->mass_w_points);
@@ -150,6 +157,7 @@ void point_map_water(struct sim *s, enum nodal_pressure nodal)
 		point_map_normalise(nodes, f->pressure, 1, f->mass_w_points);
 	else   /* nodes no water point reaches keep the reset's 0, as the mean gives them */
 		p2g_scalar_linear_fit(&s->grid, w, w->mass, w->pressure, f->fit_moments, f->pressure);
+	#pragma omp parallel for schedule(static)
 	for (idx_t I = 0; I < nodes; I++)   /* Eq. 50: grid porosity times sum S rho_w V_wp */
 		f->mass_w[I] = f->porosity[I] * s->rho_w * f->mass_w_v[I];
 	memcpy(f->v_w_old, f->v_w, 2 * sizeof(double) * (size_t)nodes);

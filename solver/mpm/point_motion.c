@@ -10,7 +10,8 @@
 /* x_p += dt v_p for every point of the set; returns how many then lie beyond a grid face. */
 static idx_t advance_positions(const struct sim *s, struct particles *p)
 {
-	idx_t beyond = 0;
+	idx_t beyond = 0;   /* a count: the same in any order */
+	#pragma omp parallel for schedule(static) reduction(+ : beyond)
 	for (idx_t q = 0; q < p->n; q++) {
 		p->x[2 * q] += s->dt * p->v[2 * q];
 		p->x[2 * q + 1] += s->dt * p->v[2 * q + 1];
@@ -29,6 +30,7 @@ idx_t point_motion_update(struct sim *s, struct particles *p, const double *v_ne
 		point_gather_velocity(s, p, v_new, p->v);   /* APIC's point velocity is the PIC one */
 		return move_positions ? advance_positions(s, p) : 0;
 	}
+	#pragma omp parallel for schedule(static)
 	for (idx_t I = 0; I < 2 * s->grid.node_count; I++)
 		v_old[I] = v_new[I] - v_old[I];
 	const idx_t beyond = g2p_flip_update(&s->grid, p, v_new, v_old, s->spec->formulation.flip_fraction, s->dt,

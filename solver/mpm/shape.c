@@ -9,6 +9,8 @@
 
 #include <math.h>
 
+#include "point_blocks.h"
+
 int shape_support(enum case_shape kind)
 {
 	return kind == SHAPE_LINEAR ? 2 : kind == SHAPE_CUBIC_BSPLINE ? 4 : 3;   /* GIMP: 3 (half width <= h/2) */
@@ -253,6 +255,10 @@ enum poro_status shape_evaluate(const struct grid *g, enum case_shape kind, stru
 				bad = q;
 		}
 	}
+	if (p->blocks && bad < 0)   /* the scatters' order follows the new node0 (point_blocks.h) */
+		point_blocks_sort(p->blocks, p);
+	else if (p->blocks)
+		p->blocks->n = -1;
 	if (bad >= 0)
 		return poro_error_set(err, PORO_ESOLVER,
 				      "%s point %ld left the grid at (%.6g, %.6g) m", set_name, (long)bad,

@@ -82,8 +82,9 @@ int shape_1d_gimp_cell_centre(double xi, double half_width, idx_t cells, double 
  * Returns 0, or -1 if x lies outside the grid. */
 int shape_weights_at(const struct grid *g, enum case_shape kind, const double x[2], idx_t *node0, double *w);
 
-/* Fills p->node0 and p->shape for every point (the shape cache, particles.h). Returns
- * PORO_ESOLVER naming the first point found outside the grid. */
+/* Fills p->node0 and p->shape for every point (the shape cache, particles.h) and, when p has
+ * scatter blocks, sorts them by the new node0 (point_blocks.h). Returns PORO_ESOLVER naming the
+ * first point found outside the grid (the blocks are then stale). */
 enum poro_status shape_evaluate(const struct grid *g, enum case_shape kind, struct particles *p,
 				const char *set_name, struct poro_error *err);
 

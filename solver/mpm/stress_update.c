@@ -17,6 +17,7 @@ enum poro_status stress_update(struct sim *s)
 	 * node-wise averaging, on the total J^{t+1}); the stress keeps the point's own J */
 	const double *J_v = NULL;
 	if (s->spec->formulation.specific_volume == SPECIFIC_VOLUME_NODAL_AVERAGE) {
+		#pragma omp parallel for schedule(static)
 		for (idx_t q = 0; q < p->n; q++)
 			s->soil_scalar[q] = p->volume[q] / p->volume0[q];
 		point_map_average_nodewise(s, s->soil_scalar, s->soil_coef);

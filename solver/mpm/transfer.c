@@ -1,40 +1,41 @@
 /*
  * transfer.c - P2G scatters and G2P gathers over the shape cache (see transfer.h).
  *
- * Scatters are serial: several points share nodes, and a race-free parallel scatter (colouring or
- * per-thread grids) is a performance change that must keep these results bit-for-bit, so it lives
- * behind this same interface when it comes. Gathers are independent per point and run in parallel.
+ * Gathers are independent per point and run in parallel in index order. Scatters share nodes
+ * between neighbouring points: they run in parallel in the block order of point_blocks.h, four
+ * colours of blocks one after another, so that no two threads add into one node and every node's
+ * sum is formed in an order the thread count does not change (the file comment there says why
+ * this design and what it costs; docs/performance.md, "Parallel scatters", the figures). The
+ * loops' bodies are those of the serial kernels: only the order of the points changed.
  */
-#include <string.h>
-
 #include "transfer.h"
 
 void p2g_scalar(const struct grid *g, const struct particles *p, const double *weight,
 		const double *value, double *out)
 {
-	for (idx_t q = 0; q < p->n; q++) {
+	FOR_POINTS_BY_BLOCK(p, q, {
 		double s = (weight ? weight[q] : 1.0) * (value ? value[q] : 1.0);
 		FOR_SUPPORT(g, p, q, { out[I] += wk * s; });
-	}
+	});
 }
 
 void p2g_vector(const struct grid *g, const struct particles *p, const double *weight,
 		const double *value, double *out)
 {
-	for (idx_t q = 0; q < p->n; q++) {
+	FOR_POINTS_BY_BLOCK(p, q, {
 		double s = weight ? weight[q] : 1.0;
 		double vx = s * value[2 * q], vy = s * value[2 * q + 1];
 		FOR_SUPPORT(g, p, q, {
 			out[2 * I] += wk * vx;
 			out[2 * I + 1] += wk * vy;
 		});
-	}
+	});
 }
 
 void p2g_internal_force(const struct grid *g, const struct particles *p, const double *weight,
 			const double *stress, const double *iso, double *out)
 {
-	for (idx_t q = 0; q < p->n; q++) {
+	FOR_POINTS_BY_BLOCK(p, q, {
 		double V = weight ? weight[q] : 1.0;
 		double sp = iso ? iso[q] : 0.0;
 		double sxx = sp, syy = sp, sxy = 0.0;
@@ -48,7 +49,7 @@ void p2g_internal_force(const struct grid *g, const struct particles *p, const d
 			out[2 * I] -= sxx * gx + sxy * gy;
 			out[2 * I + 1] -= sxy * gx + syy * gy;
 		});
-	}
+	});
 }
 
 void g2p_scalar(const struct grid *g, const struct particles *p, const double *node, double *out)
@@ -92,14 +93,13 @@ void g2p_vector_gradient(const struct grid *g, const struct particles *p, const 
 
 void p2g_batch(const struct grid *g, const struct particles *p, const struct p2g_batch *b)
 {
-	for (idx_t q = 0; q < p->n; q++)
-		p2g_batch_point(g, p, q, b);
+	FOR_POINTS_BY_BLOCK(p, q, { p2g_batch_point(g, p, q, b); });
 }
 
 void p2g_point_gradient(const struct grid *g, const struct particles *p, const double *weight, const double *node,
 			double *out)
 {
-	for (idx_t q = 0; q < p->n; q++) {
+	FOR_POINTS_BY_BLOCK(p, q, {
 		double sx = 0.0, sy = 0.0;
 		FOR_SUPPORT(g, p, q, {
 			sx += gx * node[I];
@@ -110,18 +110,18 @@ void p2g_point_gradient(const struct grid *g, const struct particles *p, const d
 			out[2 * I] += wk * fx;
 			out[2 * I + 1] += wk * fy;
 		});
-	}
+	});
 }
 
 void p2g_point_divergence(const struct grid *g, const struct particles *p, const double *weight,
 			  const double *node, double *out)
 {
-	for (idx_t q = 0; q < p->n; q++) {
+	FOR_POINTS_BY_BLOCK(p, q, {
 		double div = 0.0;
 		FOR_SUPPORT(g, p, q, { div += node[2 * I] * gx + node[2 * I + 1] * gy; });
 		const double s = (weight ? weight[q] : 1.0) * div;
 		FOR_SUPPORT(g, p, q, { out[I] += wk * s; });
-	}
+	});
 }
 
 idx_t g2p_flip_update(const struct grid *g, struct particles *p, const double *v_new, const double *dv, double alpha,
@@ -174,8 +174,8 @@ void p2g_scalar_linear_fit(const struct grid *g, const struct particles *p, cons
 	const idx_t nx = g->nodes[0];
 	enum { W, WX, WY, WXX, WXY, WYY, WV, WVX, WVY, MOMENTS };   /* sums of w, w dx, ..., w v dy */
 	double *m = moments;
-	memset(m, 0, sizeof(double) * MOMENTS * (size_t)g->node_count);
-	for (idx_t q = 0; q < p->n; q++) {
+	grid_zero(m, MOMENTS * (size_t)g->node_count);
+	FOR_POINTS_BY_BLOCK(p, q, {
 		const struct shape_factors f = particle_shape(p, q);
 		double dX[SHAPE_SUPPORT_MAX], dY[SHAPE_SUPPORT_MAX];   /* X_a - x_p: minus x_p - x_I */
 		support_offsets(f.wx, S, g->h, dX);
@@ -189,8 +189,9 @@ void p2g_scalar_linear_fit(const struct grid *g, const struct particles *p, cons
 				M[WXX] += c * dx * dx, M[WXY] += c * dx * dy, M[WYY] += c * dy * dy;
 				M[WV] += c * v, M[WVX] += c * v * dx, M[WVY] += c * v * dy;
 			}
-	}
+	});
 	const double spread_min = LINEAR_FIT_SPREAD_MIN * g->h * g->h;
+	#pragma omp parallel for schedule(static)
 	for (idx_t I = 0; I < g->node_count; I++) {
 		const double *M = m + MOMENTS * (size_t)I;
 		if (!(M[W] > 0.0))
@@ -217,7 +218,7 @@ void p2g_affine_momentum(const struct grid *g, const struct particles *p, const 
 {
 	const int S = p->support;
 	const idx_t nx = g->nodes[0];
-	for (idx_t q = 0; q < p->n; q++) {
+	FOR_POINTS_BY_BLOCK(p, q, {
 		const struct shape_factors f = particle_shape(p, q);
 		double dX[SHAPE_SUPPORT_MAX], dY[SHAPE_SUPPORT_MAX];
 		support_offsets(f.wx, S, g->h, dX);
@@ -230,7 +231,7 @@ void p2g_affine_momentum(const struct grid *g, const struct particles *p, const 
 				out[2 * I] += mS * (v[2 * q] + Cq[0] * dX[a] + Cq[1] * dY[b]);
 				out[2 * I + 1] += mS * (v[2 * q + 1] + Cq[2] * dX[a] + Cq[3] * dY[b]);
 			}
-	}
+	});
 }
 
 void g2p_affine_velocity(const struct grid *g, const struct particles *p, const double *node, double *v,

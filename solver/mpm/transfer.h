@@ -6,6 +6,11 @@
  * output (the caller zeroes it); gathers OVERWRITE their per-point output. A NULL per-point
  * weight or value array means 1.
  *
+ * Every kernel runs on the calling OpenMP team's threads. Gathers take the points in any order.
+ * Scatters take them in the block order of point_blocks.h (FOR_POINTS_BY_BLOCK), so that each
+ * node's sum is formed in the same order, and is the same bit for bit, at any thread count; a
+ * phase that scatters in a loop of its own (p2g_batch_point below) runs that loop the same way.
+ *
  * Nodal vectors and per-point vectors are interleaved (x, y). Per-point 2x2 tensors are row-major
  * (xx, xy, yx, yy). Stresses are (xx, yy, xy, zz).
  */
@@ -13,6 +18,7 @@
 #define PORO_TRANSFER_H
 
 #include "grid.h"
+#include "point_blocks.h"
 
 /* out_I += sum_p S_Ip weight_p value_p  (mass, Eq. 44; porosity numerator, Eq. 46; ...). */
 void p2g_scalar(const struct grid *g, const struct particles *p, const double *weight,
@@ -73,8 +79,9 @@ void g2p_affine_velocity(const struct grid *g, const struct particles *p, const 
 
 /* Per-point kernels, for a phase that is one loop over the points (STYLE 1) and needs several
  * transfers of the same point: each point's shape factors are then read once instead of once a
- * transfer. Every output gets the same sums in the same order as the whole-set kernels above,
- * so a fused loop's results are bit for bit those of the separate calls. */
+ * transfer. Run in a FOR_POINTS_BY_BLOCK loop, every output gets the same sums in the same order
+ * as the whole-set kernels above, so a fused loop's results are bit for bit those of the
+ * separate calls. */
 
 /* Iterates the support nodes of point q: node index `I`, shape weight `wk`, gradient `gx`, `gy`.
  * The quadratic B-spline's 3x3 support (the default shape) gets its own copy of the body with
@@ -122,7 +129,7 @@ struct p2g_batch {
 	struct p2g_channel vector;
 };
 
-/* The batch's scatters for point q alone. */
+/* The batch's scatters for point q alone, in a FOR_POINTS_BY_BLOCK loop (point_blocks.h). */
 static inline void p2g_batch_point(const struct grid *g, const struct particles *p, idx_t q,
 				   const struct p2g_batch *b)
 {

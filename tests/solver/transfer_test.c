@@ -15,7 +15,14 @@
  * APIC's. The linear-fit scatter (p2g_scalar_linear_fit, the Laplacian's nodal pressure) returns
  * a linear point field's value at every node the points reach, edge nodes included, where the
  * mass-weighted mean it replaces is visibly off (the hydrostatic pressure's bias at a wall).
+ * The scatters run in parallel in the block order of point_blocks.h when the set has blocks: on a
+ * random cloud over a grid of many blocks, a third of it next to the edges and some points on
+ * them, every scatter matches a brute-force serial sum in index order from shape_1d to 1e-13 of
+ * its largest entry (the linear fit: the same kernel run serially in index order), and gives the
+ * same bits on one thread as on two.
  */
+#include <omp.h>
+
 #include "../harness.h"
 #include "particles.h"
 #include "shape.h"
@@ -364,6 +371,175 @@ static void check_linear_fit(enum case_shape kind, const char *label)
 	particles_release(&p);
 }
 
+#define CLOUD_POINTS 20000
+#define PARALLEL_TOLERANCE 1e-13   /* of the largest entry of the output */
+
+/* Every scatter of transfer.h into one output array, the outputs laid side by side:
+ * scalar [N], vector [2N], internal force [2N], batch [4N + 2N], point gradient [2N], point
+ * divergence [N], affine momentum [2N], linear fit [N] (moments: scratch). */
+enum { OUT_SCALAR = 0, OUT_VECTOR = 1, OUT_FORCE = 3, OUT_BATCH = 5, OUT_GRADIENT = 11, OUT_DIVERGENCE = 13,
+       OUT_AFFINE = 14, OUT_FIT = 16, OUT_WIDTH = 17 };
+
+struct cloud {
+	double *value[4], *vec, *stress, *iso, *node;
+};
+
+static void scatter_all(const struct grid *g, struct particles *p, const struct cloud *c, double *out,
+			double *moments)
+{
+	const size_t N = (size_t)g->node_count;
+	memset(out, 0, OUT_WIDTH * N * sizeof(double));
+	p2g_scalar(g, p, p->mass, c->value[0], out + OUT_SCALAR * N);
+	p2g_vector(g, p, p->mass, c->vec, out + OUT_VECTOR * N);
+	p2g_internal_force(g, p, p->volume, c->stress, c->iso, out + OUT_FORCE * N);
+	double *b0 = out + OUT_BATCH * N;
+	const struct p2g_batch b = {
+		.scalars = 4,
+		.scalar = {{NULL, c->value[0], b0}, {p->mass, c->value[1], b0 + N}, {c->value[2], NULL, b0 + 2 * N},
+			   {p->mass, c->value[3], b0 + 3 * N}},
+		.vector = {p->mass, c->vec, b0 + 4 * N},
+	};
+	p2g_batch(g, p, &b);
+	p2g_point_gradient(g, p, p->volume, c->node, out + OUT_GRADIENT * N);
+	p2g_point_divergence(g, p, p->volume, c->node, out + OUT_DIVERGENCE * N);
+	p2g_affine_momentum(g, p, p->mass, c->vec, p->C, out + OUT_AFFINE * N);
+	p2g_scalar_linear_fit(g, p, p->mass, c->value[1], moments, out + OUT_FIT * N);
+}
+
+/* The same sums, point by point in index order, from brute-force shape functions (shape_1d);
+ * not the linear fit. */
+static void scatter_brute_force(const struct grid *g, enum case_shape kind, const struct particles *p,
+				const struct cloud *c, double *out)
+{
+	const size_t N = (size_t)g->node_count;
+	const int n = shape_support(kind);
+	memset(out, 0, OUT_WIDTH * N * sizeof(double));
+	for (idx_t q = 0; q < p->n; q++) {
+		double S[SHAPE_NODES_MAX], Sx[SHAPE_NODES_MAX], Sy[SHAPE_NODES_MAX], xp[2] = {0, 0};
+		const idx_t base = brute_shape(g, kind, p->x + 2 * q, S, Sx, Sy);
+		const double m = p->mass[q], V = p->volume[q], *v = c->vec + 2 * q, *sg = c->stress + 4 * q;
+		const double sxx = V * (sg[0] + c->iso[q]), syy = V * (sg[1] + c->iso[q]), sxy = V * sg[2];
+		double grad[2] = {0, 0}, div = 0;
+		for (int a = 0; a < n * n; a++) {
+			const idx_t I = base + a % n + (a / n) * g->nodes[0];
+			xp[0] += S[a] * (g->origin[0] + (double)(I % g->nodes[0]) * g->h);
+			xp[1] += S[a] * (g->origin[1] + (double)(I / g->nodes[0]) * g->h);
+			grad[0] += Sx[a] * c->node[I], grad[1] += Sy[a] * c->node[I];
+			div += Sx[a] * c->node[2 * I] + Sy[a] * c->node[2 * I + 1];
+		}
+		for (int a = 0; a < n * n; a++) {
+			const idx_t I = base + a % n + (a / n) * g->nodes[0];
+			const double dx = g->origin[0] + (double)(I % g->nodes[0]) * g->h - xp[0];
+			const double dy = g->origin[1] + (double)(I / g->nodes[0]) * g->h - xp[1];
+			const double *C = p->C + 4 * q;
+			out[OUT_SCALAR * N + I] += S[a] * m * c->value[0][q];
+			out[OUT_VECTOR * N + 2 * I] += S[a] * m * v[0];
+			out[OUT_VECTOR * N + 2 * I + 1] += S[a] * m * v[1];
+			out[OUT_FORCE * N + 2 * I] -= sxx * Sx[a] + sxy * Sy[a];
+			out[OUT_FORCE * N + 2 * I + 1] -= sxy * Sx[a] + syy * Sy[a];
+			out[OUT_BATCH * N + I] += S[a] * c->value[0][q];
+			out[(OUT_BATCH + 1) * N + I] += S[a] * m * c->value[1][q];
+			out[(OUT_BATCH + 2) * N + I] += S[a] * c->value[2][q];
+			out[(OUT_BATCH + 3) * N + I] += S[a] * m * c->value[3][q];
+			out[(OUT_BATCH + 4) * N + 2 * I] += S[a] * m * v[0];
+			out[(OUT_BATCH + 4) * N + 2 * I + 1] += S[a] * m * v[1];
+			out[OUT_GRADIENT * N + 2 * I] += S[a] * V * grad[0];
+			out[OUT_GRADIENT * N + 2 * I + 1] += S[a] * V * grad[1];
+			out[OUT_DIVERGENCE * N + I] += S[a] * V * div;
+			out[OUT_AFFINE * N + 2 * I] += S[a] * m * (v[0] + C[0] * dx + C[1] * dy);
+			out[OUT_AFFINE * N + 2 * I + 1] += S[a] * m * (v[1] + C[2] * dx + C[3] * dy);
+		}
+	}
+}
+
+/* A random cloud on a grid of 3 x 5 blocks (point_blocks.h), a third of it within 1.3 cells of
+ * an edge and every 97th point on an edge or a corner, through every scatter with blocks: on one
+ * thread and on two the same bits, and each output within PARALLEL_TOLERANCE of its largest
+ * entry of the brute-force sums (the linear fit: of the same kernel without blocks, which runs
+ * serially in index order). */
+static void check_parallel_scatters(enum case_shape kind, const char *label)
+{
+	const double h = 0.0473;
+	struct case_grid spec = {.origin = {-1.917, 0.661}, .extent = {150 * h, 29 * h}, .cell_size = h};
+	struct grid g;
+	struct particles p;
+	struct cloud c;
+	char name[96];
+	grid_init(&g, &spec, NULL);
+	particles_init(&p, CLOUD_POINTS, 0, NULL);
+	particles_add_affine(&p, NULL);
+	particles_add_blocks(&p, &g, NULL);
+	for (int k = 0; k < 4; k++)
+		c.value[k] = malloc(CLOUD_POINTS * sizeof(double));
+	c.vec = malloc(2 * CLOUD_POINTS * sizeof(double));
+	c.stress = malloc(4 * CLOUD_POINTS * sizeof(double));
+	c.iso = malloc(CLOUD_POINTS * sizeof(double));
+	for (idx_t q = 0; q < p.n; q++) {
+		const double edge = 1.3 * h, X = spec.extent[0], Y = spec.extent[1];
+		double x = rnd(0, X), y = rnd(0, Y);
+		if (q % 3 == 0)   /* next to one of the four edges */
+			switch (q % 4) {
+			case 0: x = rnd(0, edge); break;
+			case 1: x = X - rnd(0, edge); break;
+			case 2: y = rnd(0, edge); break;
+			default: y = Y - rnd(0, edge); break;
+			}
+		if (q % 97 == 0)   /* on an edge, or in a corner */
+			x = q % 2 ? 0.0 : X, y = q % 3 ? y : q % 5 ? 0.0 : Y;
+		p.x[2 * q] = spec.origin[0] + x, p.x[2 * q + 1] = spec.origin[1] + y;
+		p.mass[q] = rnd(0.3, 2.9), p.volume[q] = rnd(0.5e-3, 1.1e-3);
+		for (int k = 0; k < 4; k++)
+			c.value[k][q] = rnd(-3.7, 5.3);
+		for (int k = 0; k < 2; k++)
+			c.vec[2 * q + k] = rnd(-1.9, 1.9);
+		for (int k = 0; k < 4; k++)
+			c.stress[4 * q + k] = rnd(-2.3e4, 1.1e4), p.C[4 * q + k] = rnd(-20, 20);
+		c.iso[q] = rnd(-5.1e3, 3.3e3);
+	}
+	const int sorted = shape_evaluate(&g, kind, &p, "test", NULL) == PORO_OK && point_blocks_of(&p) != NULL;
+	const size_t N = (size_t)g.node_count;
+	c.node = malloc(2 * N * sizeof(double));
+	for (size_t I = 0; I < 2 * N; I++)
+		c.node[I] = rnd(-2.3, 2.3);
+	double *one = malloc(OUT_WIDTH * N * sizeof(double)), *two = malloc(OUT_WIDTH * N * sizeof(double));
+	double *ref = malloc(OUT_WIDTH * N * sizeof(double)), *moments = malloc(9 * N * sizeof(double));
+	const int threads = omp_get_max_threads();
+	omp_set_num_threads(1);
+	scatter_all(&g, &p, &c, one, moments);
+	omp_set_num_threads(2);
+	scatter_all(&g, &p, &c, two, moments);
+	omp_set_num_threads(threads);
+	idx_t differ = 0;
+	for (size_t k = 0; k < OUT_WIDTH * N; k++)
+		differ += memcmp(one + k, two + k, sizeof(double)) != 0;
+	snprintf(name, sizeof name, "%s_parallel_scatters_same_bits_on_one_and_two_threads", label);
+	CHECK(sorted && differ == 0, name, "sorted %d; %ld of %ld nodal values differ", sorted, (long)differ,
+	      (long)(OUT_WIDTH * N));
+
+	scatter_brute_force(&g, kind, &p, &c, ref);
+	struct point_blocks *blocks = p.blocks;   /* without blocks the kernels run serially in index order */
+	p.blocks = NULL;
+	p2g_scalar_linear_fit(&g, &p, p.mass, c.value[1], moments, ref + OUT_FIT * N);
+	p.blocks = blocks;
+	static const struct { int first, width; const char *what; } outputs[] = {
+		{OUT_SCALAR, 1, "scalar"}, {OUT_VECTOR, 2, "vector"}, {OUT_FORCE, 2, "internal_force"},
+		{OUT_BATCH, 6, "batch"}, {OUT_GRADIENT, 2, "point_gradient"}, {OUT_DIVERGENCE, 1, "point_divergence"},
+		{OUT_AFFINE, 2, "affine_momentum"}, {OUT_FIT, 1, "linear_fit"}};
+	for (size_t k = 0; k < sizeof outputs / sizeof outputs[0]; k++) {
+		double scale;
+		const size_t at = (size_t)outputs[k].first * N, count = (size_t)outputs[k].width * N;
+		const double err = max_abs_difference(two + at, ref + at, count, &scale);
+		snprintf(name, sizeof name, "%s_parallel_%s_matches_serial_brute_force", label, outputs[k].what);
+		CHECK(sorted && scale > 0.0 && err <= PARALLEL_TOLERANCE * scale, name, "difference %.2e of %.2e",
+		      err, scale);
+	}
+	for (int k = 0; k < 4; k++)
+		free(c.value[k]);
+	free(c.vec), free(c.stress), free(c.iso), free(c.node);
+	free(one), free(two), free(ref), free(moments);
+	particles_release(&p);
+}
+
 int main(void)
 {
 	check_linear_fit(SHAPE_LINEAR, "linear");
@@ -375,5 +551,8 @@ int main(void)
 	check_fused(SHAPE_LINEAR, "linear");
 	check_fused(SHAPE_QUADRATIC_BSPLINE, "quadratic_bspline");
 	check_fused(SHAPE_CUBIC_BSPLINE, "cubic_bspline");
+	check_parallel_scatters(SHAPE_LINEAR, "linear");
+	check_parallel_scatters(SHAPE_QUADRATIC_BSPLINE, "quadratic_bspline");
+	check_parallel_scatters(SHAPE_CUBIC_BSPLINE, "cubic_bspline");
 	HARNESS_EXIT();
 }

@@ -116,7 +116,7 @@ static void map_masses(struct sim *s)
 	const struct particles *p = &s->soil, *w = &s->water;
 	const int implicit_drag = s->spec->formulation.drag == DRAG_IMPLICIT;
 	double *Ms = f->mass_s, *Mf = f->mass_w, *Ps = f->v_s, *Pf = f->v_w, *n = f->porosity, *C = e->drag;
-	for (idx_t q = 0; q < p->n; q++) {
+	FOR_POINTS_BY_BLOCK(p, q, {   /* a scatter into q's support: in parallel (point_blocks.h) */
 		const double ms = p->mass[q], mf = w->mass[q], msn = ms * p->porosity[q];
 		const double *vs = p->v + 2 * q, *vf = w->v + 2 * q, cd = implicit_drag ? e->drag_point[q] : 0.0;
 		FOR_SUPPORT(g, p, q, {
@@ -129,7 +129,7 @@ static void map_masses(struct sim *s)
 			Pf[2 * I + 1] += wk * mf * vf[1];
 			C[I] += wk * cd;
 		});
-	}
+	});
 	point_map_normalise(g->node_count, n, 1, Ms);
 }
 
@@ -152,7 +152,7 @@ static void map_forces(struct sim *s)
 	const int explicit_drag = s->spec->formulation.drag == DRAG_EXPLICIT;
 	const double *n = f->porosity;
 	double *Fs = f->force, *Ff = f->force_w;
-	for (idx_t q = 0; q < p->n; q++) {
+	FOR_POINTS_BY_BLOCK(p, q, {   /* a scatter into q's support, q's own grad n: in parallel */
 		double *grad_n = e->grad_n + 2 * q;
 		grad_n[0] = grad_n[1] = 0.0;
 		FOR_SUPPORT(g, p, q, {
@@ -171,7 +171,7 @@ static void map_forces(struct sim *s)
 			Ff[2 * I] += wk * bx - pf * gx;
 			Ff[2 * I + 1] += wk * by - pf * gy;
 		});
-	}
+	});
 }
 
 /* Step 2: maps and forces (2a, 2b), the velocities v^t, the tractions. */
@@ -255,16 +255,15 @@ static enum poro_status check_motion(struct sim *s)
 {
 	const struct particles *p = &s->soil, *w = &s->water;
 	const double limit = UNSTABLE_CELL_FRACTION * s->grid.h / s->dt;
-	idx_t bad = -1;
-	const char *phase = "solid";
-	for (idx_t q = 0; q < p->n && bad < 0; q++) {
-		if (!(hypot(p->v[2 * q], p->v[2 * q + 1]) <= limit))
+	idx_t bad = p->n;   /* the lowest such point, as a serial search would find it */
+#pragma omp parallel for schedule(static) reduction(min : bad)
+	for (idx_t q = 0; q < p->n; q++)
+		if (q < bad && !(hypot(p->v[2 * q], p->v[2 * q + 1]) <= limit &&
+				 hypot(w->v[2 * q], w->v[2 * q + 1]) <= limit))
 			bad = q;
-		else if (!(hypot(w->v[2 * q], w->v[2 * q + 1]) <= limit))
-			bad = q, phase = "fluid";
-	}
-	if (bad < 0)
+	if (bad == p->n)
 		return PORO_OK;
+	const char *phase = hypot(p->v[2 * bad], p->v[2 * bad + 1]) <= limit ? "fluid" : "solid";
 	const double *v = (phase[0] == 's' ? p->v : w->v) + 2 * bad;
 	return poro_error_set(&s->err, PORO_ESOLVER, "soil point %ld at (%.6g, %.6g) m: its %s velocity %.6g m/s "
 			      "moves it more than %g of a cell in one step at step %ld (t = %.6g s): the explicit "

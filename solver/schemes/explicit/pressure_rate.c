@@ -63,13 +63,13 @@ static void project_constant(struct sim *s)
 	const struct particles *p = &s->soil;
 	double *m = e->rate_moments, *a = e->rate_nodal;
 	memset(m, 0, 2 * sizeof(double) * (size_t)g->node_count);
-	for (idx_t q = 0; q < p->n; q++) {
+	FOR_POINTS_BY_BLOCK(p, q, {   /* a scatter: in parallel (point_blocks.h) */
 		const double V = p->volume[q], Vr = V * e->pressure_rate[q];
 		FOR_SUPPORT(g, p, q, {
 			m[2 * I] += wk * Vr;
 			m[2 * I + 1] += wk * V;
 		});
-	}
+	});
 #pragma omp parallel for schedule(static)
 	for (idx_t I = 0; I < g->node_count; I++)
 		a[I] = m[2 * I + 1] > 0.0 ? m[2 * I] / m[2 * I + 1] : 0.0;
@@ -121,7 +121,7 @@ static void project_linear(struct sim *s)
 	enum { W, WX, WY, WXX, WXY, WYY, WR, WRX, WRY, MOMENTS };
 	double *m = e->rate_moments, *a = e->rate_nodal;
 	memset(m, 0, MOMENTS * sizeof(double) * (size_t)g->node_count);
-	for (idx_t q = 0; q < p->n; q++) {
+	FOR_POINTS_BY_BLOCK(p, q, {   /* a scatter into q's support: in parallel (point_blocks.h) */
 		const struct shape_factors f = particle_shape(p, q);
 		double dX[SHAPE_SUPPORT_MAX], dY[SHAPE_SUPPORT_MAX];   /* (X_a - x_p) / h: minus Q's dx */
 		offsets(f.wx, S, dX);
@@ -135,7 +135,7 @@ static void project_linear(struct sim *s)
 				M[WXX] += w * dx * dx, M[WXY] += w * dx * dy, M[WYY] += w * dy * dy;
 				M[WR] += w * r, M[WRX] += w * r * dx, M[WRY] += w * r * dy;
 			}
-	}
+	});
 #pragma omp parallel for schedule(static)
 	for (idx_t I = 0; I < g->node_count; I++) {
 		const double *M = m + MOMENTS * (size_t)I;

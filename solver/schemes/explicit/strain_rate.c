@@ -72,11 +72,11 @@ static void cell_averages(struct sim *s)
 	const struct particles *p = &s->soil, *w = &s->water;
 	double *sums = e->cell_sums;
 	memset(sums, 0, 4 * sizeof(double) * (size_t)s->grid.cell_count);
-	for (idx_t q = 0; q < p->n; q++) {
+	FOR_POINTS_BY_BLOCK(p, q, {   /* q's cell is in q's block: in parallel (point_blocks.h) */
 		double *c = sums + 4 * (size_t)e->cell[q];
 		c[0] += p->mass[q] * e->div_s[q], c[1] += p->mass[q];
 		c[2] += w->mass[q] * e->div_f[q], c[3] += w->mass[q];
-	}
+	});
 #pragma omp parallel for schedule(static)
 	for (idx_t q = 0; q < p->n; q++) {
 		const double *c = sums + 4 * (size_t)e->cell[q];   /* the point's own mass is in it: > 0 */
@@ -118,10 +118,10 @@ void explicit_cell_pressure(struct sim *s)
 	struct particles *w = &s->water;
 	double *sums = e->cell_sums;
 	memset(sums, 0, 4 * sizeof(double) * (size_t)s->grid.cell_count);
-	for (idx_t q = 0; q < w->n; q++) {
+	FOR_POINTS_BY_BLOCK(w, q, {   /* q's cell is in q's block: in parallel (point_blocks.h) */
 		double *c = sums + 4 * (size_t)e->cell[q];
 		c[0] += w->mass[q] * w->pressure[q], c[1] += w->mass[q];
-	}
+	});
 #pragma omp parallel for schedule(static)
 	for (idx_t q = 0; q < w->n; q++) {
 		const double *c = sums + 4 * (size_t)e->cell[q];   /* the point's own mass is in it: > 0 */

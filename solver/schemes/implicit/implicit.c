@@ -170,7 +170,9 @@ static void map_kinematics(struct sim *s)
 	memset(e->nodal_pressure, 0, sizeof(double) * (size_t)g->node_count);
 	memset(e->fill, 0, sizeof(double) * (size_t)g->cell_count);
 	double *v = e->velocity, *a = e->acceleration;
-	for (idx_t q = 0; q < p->n; q++) {
+	/* a scatter into q's support and q's cell, both reached from q's block only: in parallel
+	 * (point_blocks.h) */
+	FOR_POINTS_BY_BLOCK(p, q, {
 		const double ms = p->mass[q], mw = q < w->n ? p->porosity[q] * s->rho_w * p->volume[q] : 0.0;
 		const double V = q < w->n ? p->volume[q] : 0.0, pi = q < w->n ? w->pressure[q] : 0.0;
 		const double *vs = p->v + 2 * q, *as = p->acceleration + 2 * q;
@@ -193,7 +195,8 @@ static void map_kinematics(struct sim *s)
 		const idx_t j = (idx_t)floor((p->x[2 * q + 1] - g->origin[1]) * g->inv_h);
 		const idx_t ci = i < g->cells[0] ? i : g->cells[0] - 1, cj = j < g->cells[1] ? j : g->cells[1] - 1;
 		e->fill[ci + cj * g->cells[0]] += p->volume[q] * g->inv_h * g->inv_h;
-	}
+	});
+#pragma omp parallel for schedule(static)
 	for (idx_t I = 0; I < g->node_count; I++) {
 		double *vI = v + DOFS_PER_NODE * (size_t)I, *aI = a + DOFS_PER_NODE * (size_t)I;
 		const double Ms = f->mass_s[I], Mw = f->mass_w[I];
@@ -277,6 +280,7 @@ static void external_forces(struct sim *s)
 	memset(f->force, 0, sizeof(double) * DIM * (size_t)nodes);
 	loads_add_tractions(s, s->time + s->dt, f->force);
 	memset(e->external, 0, sizeof(double) * (size_t)e->unknowns);
+#pragma omp parallel for schedule(static)
 	for (idx_t I = 0; I < nodes; I++) {
 		double *fI = e->external + DOFS_PER_NODE * (size_t)I;
 		for (int c = 0; c < 2; c++) {
@@ -392,8 +396,10 @@ static enum poro_status update_points(struct sim *s)
 	const double cM = 1.0 / (beta * dt * dt), cV = 1.0 / (beta * dt), cA = 0.5 / beta - 1.0;
 	/* a_{n+1} at the nodes (Eq. 8; 001's footnote to Eq. 11 corrected, spec-001 E4) */
 	double *a_new = e->acceleration_new, *du = s->f.du_s;
+#pragma omp parallel for schedule(static)
 	for (idx_t k = 0; k < e->unknowns; k++)
 		a_new[k] = cM * e->increment[k] - cV * e->velocity[k] - cA * e->acceleration[k];
+#pragma omp parallel for schedule(static)
 	for (idx_t I = 0; I < g->node_count; I++)
 		for (int c = 0; c < 2; c++)
 			du[2 * I + c] = e->increment[DOFS_PER_NODE * (size_t)I + DOF_UX + c];

@@ -10,6 +10,7 @@
  */
 #include "lu_solve.h"
 
+#include <omp.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <umfpack.h>
@@ -58,7 +59,7 @@ enum poro_status lu_solver_create(struct lu_solver **out, idx_t n, const idx_t *
 	return PORO_OK;
 }
 
-enum poro_status lu_solver_factorise(struct lu_solver *s, const double *values, struct poro_error *err)
+static enum poro_status factorise(struct lu_solver *s, const double *values, struct poro_error *err)
 {
 	if (!s->symbolic) {
 		if (umfpack_di_symbolic(s->n, s->n, s->colptr, s->rowidx, values, &s->symbolic, s->control, s->info) !=
@@ -81,8 +82,8 @@ enum poro_status lu_solver_factorise(struct lu_solver *s, const double *values, 
 	return PORO_OK;
 }
 
-enum poro_status lu_solver_solve(struct lu_solver *s, const double *b, double *x, double *backward_error,
-				 struct poro_error *err)
+static enum poro_status solve(struct lu_solver *s, const double *b, double *x, double *backward_error,
+			      struct poro_error *err)
 {
 	if (!s->numeric)
 		return poro_error_set(err, PORO_ESOLVER, "the implicit system was solved before it was factorised");
@@ -93,6 +94,31 @@ enum poro_status lu_solver_solve(struct lu_solver *s, const double *b, double *x
 	if (backward_error)
 		*backward_error = s->info[UMFPACK_OMEGA1];
 	return PORO_OK;
+}
+
+/* UMFPACK's dense kernels run on the BLAS, whose OpenMP build splits its work by the calling
+ * thread's thread count, so the factors and solutions differed in the last bits between one and
+ * two threads and the runs parted from the first step (tests/solver/thread_count_test.c). On one
+ * BLAS thread a run is the same bit for bit at any thread count of the solver, as the
+ * semi-implicit scheme's CHOLMOD solves are kept (spd_solve.c); the cost is in docs/performance.md,
+ * "Threads on every scheme". */
+enum poro_status lu_solver_factorise(struct lu_solver *s, const double *values, struct poro_error *err)
+{
+	const int threads = omp_get_max_threads();
+	omp_set_num_threads(1);
+	const enum poro_status st = factorise(s, values, err);
+	omp_set_num_threads(threads);
+	return st;
+}
+
+enum poro_status lu_solver_solve(struct lu_solver *s, const double *b, double *x, double *backward_error,
+				 struct poro_error *err)
+{
+	const int threads = omp_get_max_threads();
+	omp_set_num_threads(1);
+	const enum poro_status st = solve(s, b, x, backward_error, err);
+	omp_set_num_threads(threads);
+	return st;
 }
 
 void lu_solver_counts(const struct lu_solver *s, long *analyses, long *factorisations, long *solves,

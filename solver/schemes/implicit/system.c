@@ -37,6 +37,7 @@
 
 #include "implicit.h"
 #include "material.h"
+#include "point_blocks.h"
 #include "shape.h"
 
 #define NEIGHBOURS 25   /* nodes within two cells, 5 x 5 */
@@ -221,8 +222,10 @@ void implicit_system_assemble(struct sim *s)
 	const double dt = s->dt, cM = 1.0 / (form->newmark_beta * dt * dt);
 	const double cC = form->newmark_gamma / (form->newmark_beta * dt), alpha = e->pressure_scale;
 	const int lumped = form->mass_matrix == MASS_MATRIX_LUMPED;
-	memset(e->values, 0, sizeof(double) * (size_t)e->colptr[e->unknowns]);
-	for (idx_t q = 0; q < p->n; q++) {
+	grid_zero(e->values, (size_t)e->colptr[e->unknowns]);
+	/* a point adds into the columns of its support nodes only, rows of its support nodes: the
+	 * scatter order of point_blocks.h runs it in parallel with sums independent of the threads */
+	FOR_POINTS_BY_BLOCK(p, q, {
 		struct point_operators o;
 		point_operators(s, q, &o);
 		const struct point_physics ph = point_physics(s, q);
@@ -255,7 +258,7 @@ void implicit_system_assemble(struct sim *s)
 				add_block(e, o.node[ka], o.node[kb], nx, block);
 			}
 		}
-	}
+	});
 	/* unknowns that are not free: their rows and columns zero, a unit diagonal */
 #pragma omp parallel for schedule(static)
 	for (idx_t j = 0; j < e->unknowns; j++)
@@ -279,8 +282,9 @@ void implicit_system_assemble(struct sim *s)
  * derivative of the Cauchy stress the residual integrates with respect to the linearised strain
  * increment at x_n (spec-001 §3.4); this is, to about 1e-8. Layout of material.h (tensor shear):
  * column 2 answers eps_xy, half the engineering shear the strain vector carries. */
-static enum poro_status numerical_tangent(struct sim *s, idx_t q, const double strain[4], double vol_u,
-					  const struct material *m, int elastic_only, double T[16])
+static enum poro_status numerical_tangent(const struct sim *s, idx_t q, const double strain[4], double vol_u,
+					  const struct material *m, int elastic_only, double T[16],
+					  struct poro_error *err)
 {
 	const struct implicit_state *e = implicit_of(s);
 	const struct particles *p = &s->soil;
@@ -297,7 +301,7 @@ static enum poro_status numerical_tangent(struct sim *s, idx_t q, const double s
 			.dF = dF, .dF_zz = 1.0 + d[3], .J = p->volume[q] / p->volume0[q] * (1.0 + vol_u + dvol),
 			.stress = stress, .Be = Be, .state = state, .plastic_strain = &plastic, .elastic_only = elastic_only,
 		};
-		TRY(material_update(m, &u, &s->err));
+		TRY(material_update(m, &u, err));
 		const double scale = (c == 2 ? 2.0 : 1.0) / TANGENT_PERTURBATION;
 		for (int r = 0; r < 4; r++)
 			T[4 * r + c] = (stress[r] - p->stress[4 * q + r]) * scale;
@@ -311,6 +315,16 @@ struct point_increments {
 	double strain[4], vol_u, vol_w, dp, du[2];
 	double a_u[2], a_w[2], v_u[2], v_w[2];   /* the iterate's a_{n+1}, v_{n+1} at the point */
 };
+
+/* Keeps err as the step's error if point q is the lowest failing point so far (*failed). */
+static void keep_lowest_failure(struct sim *s, idx_t q, const struct poro_error *err, idx_t *failed)
+{
+#pragma omp critical(implicit_residual_failure)
+	if (q < *failed) {
+		*failed = q;
+		s->err = *err;
+	}
+}
 
 enum poro_status implicit_system_residual(struct sim *s)
 {
@@ -326,13 +340,16 @@ enum poro_status implicit_system_residual(struct sim *s)
 	/* a_{n+1} and v_{n+1} of the iterate at the nodes (Newmark, 001 Eq. 8); the residual starts
 	 * as f_{n+1} */
 	double *a_new = e->acceleration_new, *v_new = e->velocity_new;
+#pragma omp parallel for schedule(static)
 	for (idx_t k = 0; k < N; k++) {
 		a_new[k] = cM * e->increment[k] - cV * e->velocity[k] - cA * e->acceleration[k];
 		v_new[k] = cC * e->increment[k] - cVv * e->velocity[k] - cVa * e->acceleration[k];
 		e->residual[k] = e->external[k];
 	}
-	enum poro_status status = PORO_OK;
-	for (idx_t q = 0; q < p->n && !status; q++) {
+	idx_t failed = p->n;
+	/* q's stress and state, rows of q's support nodes: in parallel in the scatter order of
+	 * point_blocks.h; every point is updated and the failure kept is the lowest point's */
+	FOR_POINTS_BY_BLOCK(p, q, {
 		struct point_operators o;
 		point_operators(s, q, &o);
 		const struct point_physics ph = point_physics(s, q);
@@ -367,9 +384,12 @@ enum poro_status implicit_system_residual(struct sim *s)
 			.plastic_strain = p->plastic_strain + q,
 			.tangent = e->tangent && !finite ? e->tangent + 16 * (size_t)q : NULL, .elastic_only = elastic_only,
 		};
-		status = material_update(m, &u, &s->err);
-		if (!status && e->tangent && finite)
-			status = numerical_tangent(s, q, in.strain, in.vol_u, m, elastic_only, e->tangent + 16 * (size_t)q);
+		struct poro_error err;   /* this point's: the threads' share s->err (keep_lowest_failure) */
+		enum poro_status st = material_update(m, &u, &err);
+		if (!st && e->tangent && finite)
+			st = numerical_tangent(s, q, in.strain, in.vol_u, m, elastic_only, e->tangent + 16 * (size_t)q, &err);
+		if (st)
+			keep_lowest_failure(s, q, &err, &failed);
 		const double pressure = -w->pressure[q] + in.dp;   /* compression positive */
 		const double *sg = p->stress + 4 * q, pn = (1.0 - ph.n) * pressure;
 		const double partial[4] = {sg[0] - pn, sg[1] - pn, sg[2], sg[3] - pn};   /* sigma' - (1 - n) p m */
@@ -389,11 +409,12 @@ enum poro_status implicit_system_residual(struct sim *s)
 			}
 			r[DOF_P] += ph.V * o.w[k] * balance;   /* -f_p */
 		}
-	}
+	});
+#pragma omp parallel for schedule(static)
 	for (idx_t k = 0; k < N; k++)
 		if (e->kind[k] != DOF_FREE)
 			e->residual[k] = 0.0;
-	return status;
+	return failed < p->n ? s->err.code : PORO_OK;
 }
 
 void implicit_point_volumetric(const struct sim *s, idx_t q, double *eps_u, double *eps_w)

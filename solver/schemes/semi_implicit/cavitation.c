@@ -28,6 +28,7 @@
  * reaches every node whose support holds a cavitating point, in proportion, and the same column
  * carries its load (tests/verify/cavitation_test.c, docs/numerics.md "Cavitation").
  */
+#include "point_blocks.h"
 #include "semi_implicit.h"
 
 void cavitation_add_storage(struct sim *s)
@@ -42,7 +43,7 @@ void cavitation_add_storage(struct sim *s)
 	const idx_t nx = s->grid.nodes[0];
 	const double boiling = -c->fluid.cavitation_pressure;   /* internal sign: tension positive */
 	const double per_volume = 1.0 / (c->fluid.cavitated_bulk_modulus * s->dt * s->dt);
-	for (idx_t q = 0; q < w->n; q++) {
+	FOR_POINTS_BY_BLOCK(w, q, {   /* rows of q's support nodes only: in parallel (point_blocks.h) */
 		if (w->pressure[q] < boiling)
 			continue;
 		const struct shape_factors f = particle_shape(w, q);
@@ -52,5 +53,5 @@ void cavitation_add_storage(struct sim *s)
 				const idx_t I = w->node0[q] + a + b * nx;
 				ps->stencil[(size_t)I * W * W + centre] += storage * (f.wx[a] * f.wy[b]);
 			}
-	}
+	});
 }

@@ -120,6 +120,7 @@ static void mark_full_cells(struct sim *s)
 				    form->pressure_projection == PROJECTION_LAPLACIAN;
 	const double full = (nodes_laplacian ? FREE_SURFACE_FILL_NODES_LAPLACIAN : FREE_SURFACE_FILL) * g->h * g->h;
 	cell_volumes(g, &s->water, si->cell_fill);
+	#pragma omp parallel for schedule(static)
 	for (idx_t c = 0; c < g->cell_count; c++)
 		si->cell_wet[c] = si->cell_fill[c] >= full;
 	if (!s->double_point)
@@ -127,6 +128,7 @@ static void mark_full_cells(struct sim *s)
 	/* saturated soil fills a cell below the top of its column's water (file comment) */
 	const struct particles wet = semi_implicit_wet_soil(s);
 	cell_volumes(g, &wet, si->cell_fill_soil);
+	#pragma omp parallel for schedule(static)
 	for (idx_t ci = 0; ci < g->cells[0]; ci++) {
 		int below_water = 0;
 		for (idx_t cj = g->cells[1] - 1; cj >= 0; cj--) {
@@ -264,6 +266,7 @@ void free_surface_mark(struct sim *s)
 	const int weak = s->spec->formulation.free_surface == FREE_SURFACE_WEAK;
 	const int S = shape_support(s->spec->formulation.shape);
 	mark_full_cells(s);
+	#pragma omp parallel for schedule(static)
 	for (idx_t j = 0; j < g->nodes[1]; j++)
 		for (idx_t i = 0; i < g->nodes[0]; i++) {
 			const idx_t I = grid_node(g, i, j);

@@ -133,17 +133,19 @@ static inline void add_point_laplacian(struct pressure_system *ps, idx_t nx, con
 		}
 }
 
-/* Adds sum_p coef_p grad S_Ip . grad S_Jp into the stencil (Eq. 61). */
+/* Adds sum_p coef_p grad S_Ip . grad S_Jp into the stencil (Eq. 61). A point writes the rows of
+ * its support nodes only, so the points run in the scatters' block order (point_blocks.h): in
+ * parallel, and every entry the same bit for bit at any thread count. */
 static void assemble_laplacian(struct sim *s, const struct particles *p, const double *coef)
 {
 	struct semi_implicit *si = semi_implicit_of(s);
 	const idx_t nx = s->grid.nodes[0];
-	for (idx_t q = 0; q < p->n; q++) {
+	FOR_POINTS_BY_BLOCK(p, q, {
 		if (p->support == 3)
 			add_point_laplacian(&si->ps, nx, p, q, coef[q], 3);
 		else
 			add_point_laplacian(&si->ps, nx, p, q, coef[q], p->support);
-	}
+	});
 }
 
 /* Point q's terms of G_IJ = sum_p V_p S_Ip grad S_Jp (before the nodal porosity factor), for a
@@ -173,17 +175,18 @@ static inline void add_point_gradient(const struct pressure_system *ps, idx_t nx
 		}
 }
 
-/* G_IJ = f_I sum_p V_p S_Ip grad S_Jp for one set (Eqs. 67-68 before the nodal porosity factor). */
+/* G_IJ = f_I sum_p V_p S_Ip grad S_Jp for one set (Eqs. 67-68 before the nodal porosity factor),
+ * in the scatters' block order, as the Laplacian above. */
 static void add_gradient_operator(const struct sim *s, const struct particles *p, double *G)
 {
 	struct semi_implicit *si = semi_implicit_of(s);
 	const idx_t nx = s->grid.nodes[0];
-	for (idx_t q = 0; q < p->n; q++) {
+	FOR_POINTS_BY_BLOCK(p, q, {
 		if (p->support == 3)
 			add_point_gradient(&si->ps, nx, p, q, G, 3);
 		else
 			add_point_gradient(&si->ps, nx, p, q, G, p->support);
-	}
+	});
 }
 
 void pressure_gradient_operators(struct sim *s)
@@ -191,22 +194,16 @@ void pressure_gradient_operators(struct sim *s)
 	struct semi_implicit *si = semi_implicit_of(s);
 	struct pressure_system *ps = &si->ps;
 	const size_t gst = (size_t)ps->g_width * ps->g_width * 2, nodes = (size_t)s->grid.node_count;
-	memset(ps->grad_s, 0, sizeof(double) * nodes * gst);
-	memset(ps->grad_w, 0, sizeof(double) * nodes * gst);
-	/* the two operators are independent, each built by one thread in point order (so the sums
-	 * are the same whatever the thread count): with two threads, one each */
+	grid_zero(ps->grad_s, nodes * gst);
+	grid_zero(ps->grad_w, nodes * gst);
 	const struct particles wet = semi_implicit_wet_soil(s);   /* dry bodies feel no pore pressure */
-	#pragma omp parallel sections
-	{
-		#pragma omp section
-		add_gradient_operator(s, &wet, ps->grad_s);
-		#pragma omp section
-		add_gradient_operator(s, &s->water, ps->grad_w);
-	}
+	add_gradient_operator(s, &wet, ps->grad_s);
+	add_gradient_operator(s, &s->water, ps->grad_w);
 	if (s->spec->formulation.free_surface == FREE_SURFACE_WEAK) {   /* free_surface.c */
 		free_surface_add_boundary_term(s, s->f.mass_s, ps->grad_s);
 		free_surface_add_boundary_term(s, s->f.mass_w, ps->grad_w);
 	}
+	#pragma omp parallel for schedule(static)
 	for (size_t I = 0; I < nodes; I++) {
 		const double n = s->f.porosity[I];
 		for (size_t k = 0; k < gst; k++) {
@@ -221,6 +218,7 @@ void pressure_apply_gradient(const struct sim *s, const double *G, const double 
 	struct semi_implicit *si = semi_implicit_of(s);
 	const struct grid *g = &s->grid;
 	const int W = si->ps.g_width, R = si->ps.g_radius;
+	#pragma omp parallel for schedule(static)
 	for (idx_t I = 0; I < g->node_count; I++) {
 		const idx_t i = I % g->nodes[0], j = I / g->nodes[0];
 		const double *row = G + (size_t)I * W * W * 2;
@@ -252,6 +250,7 @@ static void store_correction_coupling(struct sim *s)
 	struct semi_implicit *si = semi_implicit_of(s);
 	const struct grid_fields *f = &s->f;
 	double *k = si->ps.coupling;
+	#pragma omp parallel for schedule(static)
 	for (idx_t I = 0; I < s->grid.node_count; I++)
 		for (int c = 0; c < 2; c++) {
 			const struct phase_coupling K = phase_coupling_inverse(f->mass_s[I], f->mass_w[I],
@@ -340,6 +339,7 @@ static void scale_by_mobility_ratio(struct sim *s, const struct particles *p, do
 	struct grid_fields *f = &s->f;
 	if (!s->spec->formulation.drag_in_correction)
 		return;
+	#pragma omp parallel for schedule(static)
 	for (idx_t I = 0; I < s->grid.node_count; I++) {
 		const double n = f->porosity[I], Ms = f->mass_s[I], Mw = f->mass_w[I];
 		si->mobility_ratio[I] = 1.0;
@@ -350,6 +350,7 @@ static void scale_by_mobility_ratio(struct sim *s, const struct particles *p, do
 		si->mobility_ratio[I] = with_drag / ((1 - n) * (1 - n) / Ms + n * n / Mw);
 	}
 	g2p_scalar(&s->grid, p, si->mobility_ratio, scratch);
+	#pragma omp parallel for schedule(static)
 	for (idx_t q = 0; q < p->n; q++)
 		coef[q] *= scratch[q];
 }
@@ -366,6 +367,7 @@ void pressure_divergence_rhs(struct sim *s, const double *v_s, const double *v_w
 	memset(sum_w, 0, sizeof(double) * (size_t)g->node_count);
 	p2g_point_divergence(g, &wet, wet.volume, v_s, sum_s);
 	p2g_point_divergence(g, &s->water, s->water.volume, v_w, sum_w);
+	#pragma omp parallel for schedule(static)
 	for (idx_t I = 0; I < g->node_count; I++)
 		out[I] = ((1.0 - f->porosity[I]) * sum_s[I] + f->porosity[I] * sum_w[I]) / s->dt;
 	memset(sum_s, 0, sizeof(double) * (size_t)g->node_count);
@@ -447,7 +449,7 @@ enum poro_status pressure_solve(struct sim *s)
 	struct pressure_system *ps = &si->ps;
 	const struct particles wet = semi_implicit_wet_soil(s), *p = &wet, *w = &s->water;
 	double t0 = sim_clock();
-	memset(ps->stencil, 0, sizeof(double) * (size_t)s->grid.node_count * ps->width * ps->width);
+	grid_zero(ps->stencil, (size_t)s->grid.node_count * ps->width * ps->width);
 	double diagonal_mean = 0.0;
 	if (ps->exact) {
 		memset(si->rhs, 0, sizeof(double) * (size_t)s->grid.node_count);
@@ -456,10 +458,12 @@ enum poro_status pressure_solve(struct sim *s)
 			diagonal_mean = mean_diagonal(s);
 		pressure_stabilise(s);   /* pressure_stabilisation.c */
 	} else {
+		#pragma omp parallel for schedule(static)
 		for (idx_t q = 0; q < p->n; q++) {
 			const double rho_s = s->materials[s->spec->bodies[p->body[q]].material].density;
 			s->soil_coef[q] = p->volume[q] * (1.0 - p->porosity[q]) / rho_s;
 		}
+		#pragma omp parallel for schedule(static)
 		for (idx_t q = 0; q < w->n; q++)
 			s->water_coef[q] = w->volume[q] * w->porosity[q] / s->rho_w;
 		scale_by_mobility_ratio(s, p, s->soil_coef, s->soil_scalar);
@@ -477,6 +481,7 @@ enum poro_status pressure_solve(struct sim *s)
 	s->phase_seconds[PHASE_PRESSURE_SOLVE] += sim_clock() - t1;
 	if (st)
 		return st;
+	#pragma omp parallel for schedule(static)
 	for (idx_t I = 0; I < s->grid.node_count; I++)
 		if (ps->unknown[I] >= 0)
 			si->dp[I] = ps->x[ps->unknown[I]];

@@ -104,7 +104,7 @@ static void reset_grid(struct sim *s)
 	struct semi_implicit *si = semi_implicit_of(s);
 	const size_t n = (size_t)s->grid.node_count;
 	grid_fields_reset(&s->f, &s->grid);
-#define ZERO(name, width, reset) if (reset) memset(si->name, 0, n * (width) * sizeof(double));
+#define ZERO(name, width, reset) if (reset) grid_zero(si->name, n * (width));
 	SEMI_IMPLICIT_NODAL_FIELDS(ZERO)
 #undef ZERO
 }
@@ -165,6 +165,7 @@ static void predict_velocities(struct sim *s)
 		p2g_internal_force(&s->grid, w, w->volume, NULL, w->pressure, f->force);
 	}
 	loads_add_tractions(s, s->time + dt, f->force);
+	#pragma omp parallel for schedule(static)
 	for (idx_t I = 0; I < s->grid.node_count; I++) {
 		const double n = f->porosity[I], Ms = f->mass_s[I], Mw = f->mass_w[I];
 		double Q = 0.0;            /* Eq. 58, for the water that lies in the soil */
@@ -220,6 +221,7 @@ static void correct_velocities(struct sim *s)
 		p2g_point_gradient(g, &wet, wet.volume, si->dp, si->correction_s);
 		p2g_point_gradient(g, &s->water, s->water.volume, si->dp, si->correction_w);
 	}
+	#pragma omp parallel for schedule(static)
 	for (idx_t I = 0; I < g->node_count; I++) {
 		const double n = f->porosity[I], share_s = weak ? 1.0 : 1.0 - n, share_w = weak ? 1.0 : n;
 		for (int c = 0; c < 2; c++) {
@@ -253,12 +255,14 @@ static idx_t update_points(struct sim *s)
 	if (s->spec->formulation.pore_pressure_smoothing) {
 		/* 7c with 9a: p^{t+1}_I = p^t_I + dp_I, p^t_I being the smoothed nodal pressure of
 		 * step 2 (Eq. 77's inner sum), interpolated back to the points (Eq. 77's outer sum) */
+		#pragma omp parallel for schedule(static)
 		for (idx_t I = 0; I < s->grid.node_count; I++)   /* free surface, drained faces: 0 */
 			f->pressure[I] = si->dirichlet[I] && !si->ps.exact ? 0.0 : f->pressure[I] + si->dp[I];
 		g2p_scalar(&s->grid, &s->water, f->pressure, s->water.pressure);
 	} else {
 		/* unsmoothed: each point keeps its pressure and adds the interpolated increment */
 		g2p_scalar(&s->grid, &s->water, si->dp, s->water_scalar);
+		#pragma omp parallel for schedule(static)
 		for (idx_t q = 0; q < s->water.n; q++)
 			s->water.pressure[q] += s->water_scalar[q];
 	}
@@ -271,6 +275,7 @@ static void map_displacement(struct sim *s)
 {
 	struct grid_fields *f = &s->f;
 	point_map_momentum(s, &s->soil, f->du_s);
+	#pragma omp parallel for schedule(static)
 	for (idx_t I = 0; I < s->grid.node_count; I++)
 		for (int c = 0; c < DIM; c++)
 			f->du_s[DIM * I + c] = f->mass_s[I] > 0.0 ? s->dt * f->du_s[DIM * I + c] / f->mass_s[I] : 0.0;
