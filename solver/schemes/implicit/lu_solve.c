@@ -11,7 +11,6 @@
 #include "lu_solve.h"
 
 #include <omp.h>
-#include <stdio.h>
 #include <stdlib.h>
 #include <umfpack.h>
 
