@@ -47,6 +47,22 @@ cleanup_slurm() {
 	sleep 1
 	local p
 	for p in "${daemons[@]}"; do kill -TERM "$p" 2>/dev/null; done
+	# slurmd waits for its job steps, and a step whose controller has gone retries its completion
+	# forever (a cleanup that only waited hung there): after 5 s what is left of this test's Slurm
+	# is killed, the daemons, and the job steps and the pilots' programs whose environment names
+	# this test's slurm.conf (the server, which has it too, is stopped by svc_cleanup)
+	local alive i e
+	for i in $(seq 50); do
+		alive=0
+		for p in "${daemons[@]}"; do kill -0 "$p" 2>/dev/null && alive=1; done
+		[ "$alive" = 0 ] && break
+		sleep 0.1
+	done
+	for p in "${daemons[@]}"; do kill -KILL "$p" 2>/dev/null; done
+	for e in /proc/[0-9]*/environ; do
+		case $(cat "${e%environ}comm" 2>/dev/null) in slurmstepd | poro-worker | poro-solve) ;; *) continue ;; esac
+		grep -qsa "SLURM_CONF=$sl/slurm.conf" "$e" && kill -KILL "${e//[^0-9]/}" 2>/dev/null
+	done
 	for p in "${daemons[@]}"; do wait "$p" 2>/dev/null; done
 	svc_cleanup
 }
@@ -117,7 +133,23 @@ json.dump({"case": c}, open(sys.argv[2], "w"))
 PY
 }
 case_with_end short 0.002
-case_with_end long 1.6
+# The long job must outlast the usable 13 s of more than one pilot after the scancel on any machine
+# (a fixed end of 1.6 s ran through on an idle machine within the second pilot and was never handed
+# back): its end is scaled from this machine's wall time for 0.1 s of the case on one thread, to
+# about a minute of solver time.
+python3 - "$root/tests/cases/terzaghi.json" "$tmp/probe_case.json" <<'PY'
+import json, sys
+c = json.load(open(sys.argv[1]))
+c["time"]["end"] = 0.1
+c["output"]["frame_interval"] = 0
+json.dump(c, open(sys.argv[2], "w"))
+PY
+probe_start=$(date +%s.%N)
+OMP_NUM_THREADS=1 "$SVC_BUILD/poro-solve" run "$tmp/probe_case.json" --out "$tmp/probe" > /dev/null 2>&1
+long_end=$(python3 -c 'import sys; w = max(float(sys.argv[2]) - float(sys.argv[1]), 0.05)
+print("%.3f" % min(max(0.1 * 60 / w, 1.6), 100))' "$probe_start" "$(date +%s.%N)")
+echo "INFO slurm: the long job runs to t = $long_end s of the Terzaghi case (about a minute here)"
+case_with_end long "$long_end"
 submit() { svc_req POST /v1/jobs "$user_token" -H 'Content-Type: application/json' --data-binary "@$tmp/$1.json" > /dev/null && json '["id"]' < "$SVC_BODY"; }
 sql() { sqlite3 "file:$SVC_STATE/poro.db?mode=ro" "$1"; }
 pilots_in_squeue() { squeue -h -u root -n poro-pilot -o %i | wc -l; }
