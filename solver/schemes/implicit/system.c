@@ -269,6 +269,34 @@ void implicit_system_assemble(struct sim *s)
 		}
 }
 
+/* Where a point's stress update writes: its stress, Be, internal state and plastic strain, and
+ * the consistent tangent when wanted (NULL otherwise). */
+struct stress_target {
+	double *stress, *Be, *state, *plastic_strain, *tangent;
+};
+
+/* Point q's stress under the B-bar strain increment (xx, yy, engineering xy, zz) and volumetric
+ * increment vol_u, integrated from the step-start state (path-independent within the step,
+ * spec-001 §4.2) into out. */
+static enum poro_status stress_from_step_start(const struct sim *s, idx_t q, const struct material *m,
+					       const double strain[4], double vol_u, int elastic_only,
+					       const struct stress_target *out, struct poro_error *err)
+{
+	const struct implicit_state *e = implicit_of(s);
+	const struct particles *p = &s->soil;
+	memcpy(out->stress, e->stress_n + 4 * (size_t)q, 4 * sizeof(double));
+	memcpy(out->Be, e->Be_n + 4 * (size_t)q, 4 * sizeof(double));
+	memcpy(out->state, e->state_n + STATE_MAX * (size_t)q, STATE_MAX * sizeof(double));
+	*out->plastic_strain = e->plastic_n[q];
+	const double dF[4] = {1.0 + strain[0], 0.5 * strain[2], 0.5 * strain[2], 1.0 + strain[1]};
+	struct stress_update u = {
+		.dF = dF, .dF_zz = 1.0 + strain[3], .J = p->volume[q] / p->volume0[q] * (1.0 + vol_u),
+		.stress = out->stress, .Be = out->Be, .state = out->state, .plastic_strain = out->plastic_strain,
+		.tangent = out->tangent, .elastic_only = elastic_only,
+	};
+	return material_update(m, &u, err);
+}
+
 /* The perturbation of a strain component for the numerical tangent: the forward difference's
  * truncation error is of order delta |d2 sigma / d eps2| and its round-off of order 1e-16 |sigma| /
  * delta, both at most about 1e-8 of the tangent at strains of 1e-4 to 1 */
@@ -286,22 +314,14 @@ static enum poro_status numerical_tangent(const struct sim *s, idx_t q, const do
 					  const struct material *m, int elastic_only, double T[16],
 					  struct poro_error *err)
 {
-	const struct implicit_state *e = implicit_of(s);
 	const struct particles *p = &s->soil;
 	for (int c = 0; c < 4; c++) {
 		double d[4] = {strain[0], strain[1], strain[2], strain[3]};
 		d[c] += TANGENT_PERTURBATION;
 		const double dvol = c == 2 ? 0.0 : TANGENT_PERTURBATION;   /* B-bar: vol = xx + yy + zz */
-		double stress[4], Be[4], state[STATE_MAX], plastic = e->plastic_n[q];
-		memcpy(stress, e->stress_n + 4 * (size_t)q, sizeof stress);
-		memcpy(Be, e->Be_n + 4 * (size_t)q, sizeof Be);
-		memcpy(state, e->state_n + STATE_MAX * (size_t)q, sizeof state);
-		const double dF[4] = {1.0 + d[0], 0.5 * d[2], 0.5 * d[2], 1.0 + d[1]};
-		struct stress_update u = {
-			.dF = dF, .dF_zz = 1.0 + d[3], .J = p->volume[q] / p->volume0[q] * (1.0 + vol_u + dvol),
-			.stress = stress, .Be = Be, .state = state, .plastic_strain = &plastic, .elastic_only = elastic_only,
-		};
-		TRY(material_update(m, &u, err));
+		double stress[4], Be[4], state[STATE_MAX], plastic;
+		const struct stress_target out = {stress, Be, state, &plastic, NULL};
+		TRY(stress_from_step_start(s, q, m, d, vol_u + dvol, elastic_only, &out, err));
 		const double scale = (c == 2 ? 2.0 : 1.0) / TANGENT_PERTURBATION;
 		for (int r = 0; r < 4; r++)
 			T[4 * r + c] = (stress[r] - p->stress[4 * q + r]) * scale;
@@ -370,22 +390,14 @@ enum poro_status implicit_system_residual(struct sim *s)
 			}
 		}
 		memcpy(e->strain_increment + 4 * (size_t)q, in.strain, sizeof in.strain);
-		/* the stress from the step-start state (path-independent within the step, spec-001 §4.2) */
-		memcpy(p->stress + 4 * q, e->stress_n + 4 * (size_t)q, 4 * sizeof(double));
-		memcpy(p->Be + 4 * q, e->Be_n + 4 * (size_t)q, 4 * sizeof(double));
-		memcpy(p->state + STATE_MAX * q, e->state_n + STATE_MAX * (size_t)q, STATE_MAX * sizeof(double));
-		p->plastic_strain[q] = e->plastic_n[q];
 		const struct material *m = &s->materials[s->spec->bodies[p->body[q]].material];
 		const int finite = material_is_finite_strain(m);
-		const double dF[4] = {1.0 + in.strain[0], 0.5 * in.strain[2], 0.5 * in.strain[2], 1.0 + in.strain[1]};
-		struct stress_update u = {
-			.dF = dF, .dF_zz = 1.0 + in.strain[3], .J = p->volume[q] / p->volume0[q] * (1.0 + in.vol_u),
-			.stress = p->stress + 4 * q, .Be = p->Be + 4 * q, .state = p->state + STATE_MAX * q,
-			.plastic_strain = p->plastic_strain + q,
-			.tangent = e->tangent && !finite ? e->tangent + 16 * (size_t)q : NULL, .elastic_only = elastic_only,
+		const struct stress_target out = {
+			p->stress + 4 * q, p->Be + 4 * q, p->state + STATE_MAX * q, p->plastic_strain + q,
+			e->tangent && !finite ? e->tangent + 16 * (size_t)q : NULL,
 		};
 		struct poro_error err;   /* this point's: the threads' share s->err (keep_lowest_failure) */
-		enum poro_status st = material_update(m, &u, &err);
+		enum poro_status st = stress_from_step_start(s, q, m, in.strain, in.vol_u, elastic_only, &out, &err);
 		if (!st && e->tangent && finite)
 			st = numerical_tangent(s, q, in.strain, in.vol_u, m, elastic_only, e->tangent + 16 * (size_t)q, &err);
 		if (st)
