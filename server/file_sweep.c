@@ -6,7 +6,9 @@
  * way (a refused or broken upload, a client that disconnects: libmicrohttpd then ends the
  * request, and files_upload_abort runs). Only a server that stops without ending its requests
  * (kill -9, power loss) leaves one behind, so the sweep runs once at start-up, before the first
- * request, when no upload can be in flight. It also removes the directory of a job the database
+ * request, when no upload can be in flight. A replacement cut short the same way leaves the old
+ * version kept under ".old-<SHA-256>-<name>" (file_replace.h); the sweep puts it back when its
+ * row still names it and removes it otherwise, so every row again describes its file. It also removes the directory of a job the database
  * does not hold: DELETE /v1/jobs/{id} commits the deletion first and removes the files after,
  * so a crash in between leaves such a directory (job ids are never reused, so it belongs to no
  * one).
@@ -16,6 +18,7 @@
  * levels are left alone, and no symbolic link is followed (fstatat/openat with NOFOLLOW).
  */
 #include "file_sweep.h"
+#include "file_replace.h"
 #include "server.h"
 #include "store.h"
 
@@ -86,8 +89,31 @@ static int remove_tree(int parent, const char *name, int depth, long long *bytes
 	return rc;
 }
 
-/* Removes the temporary upload files in the attempt directories of job directory name. */
-static void sweep_tmp(int files_fd, const char *name, struct sweep_counts *counts)
+/* A kept old version (file_replace.h) in attempt directory dir of job id: back to its name when
+ * its row still has its SHA-256 (the new version's row never committed), else removed. */
+static void settle_kept(struct store *store, long long id, long long attempt, int dir, const char *entry,
+			struct sweep_counts *counts)
+{
+	char sha[65], name[129], row_sha[65];
+	int row_attempt = 0;
+	long long size;
+	struct api_error err = { 0 };
+	if (!file_replace_kept_name(entry, sha, name))
+		return;
+	enum api_code rc = store_file_find(store, id, name, (int)attempt, &row_attempt, &size, row_sha, &err);
+	if (rc != API_OK && rc != API_NOT_FOUND)
+		return; /* cannot tell: left for the next start-up */
+	if (rc == API_OK && row_attempt == attempt && strcmp(row_sha, sha) == 0) {
+		if (renameat(dir, entry, dir, name) == 0 && fsync(dir) == 0)
+			counts->kept_restored++;
+	} else if (unlinkat(dir, entry, 0) == 0) {
+		counts->kept_dropped++;
+	}
+}
+
+/* Removes the temporary upload files in the attempt directories of job directory name, and
+ * settles the old versions kept by replacements that did not finish. */
+static void sweep_tmp(int files_fd, const char *name, long long id, struct store *store, struct sweep_counts *counts)
 {
 	DIR *job = open_dir_at(files_fd, name);
 	if (!job)
@@ -101,9 +127,11 @@ static void sweep_tmp(int files_fd, const char *name, struct sweep_counts *count
 		struct dirent *f;
 		struct stat st;
 		while ((f = readdir(attempt)))
-			if (strncmp(f->d_name, TMP_PREFIX, strlen(TMP_PREFIX)) == 0 &&
-			    fstatat(dirfd(attempt), f->d_name, &st, AT_SYMLINK_NOFOLLOW) == 0 && S_ISREG(st.st_mode) &&
-			    unlinkat(dirfd(attempt), f->d_name, 0) == 0) {
+			if (strncmp(f->d_name, FILE_KEPT_PREFIX, strlen(FILE_KEPT_PREFIX)) == 0)
+				settle_kept(store, id, number, dirfd(attempt), f->d_name, counts);
+			else if (strncmp(f->d_name, TMP_PREFIX, strlen(TMP_PREFIX)) == 0 &&
+				 fstatat(dirfd(attempt), f->d_name, &st, AT_SYMLINK_NOFOLLOW) == 0 &&
+				 S_ISREG(st.st_mode) && unlinkat(dirfd(attempt), f->d_name, 0) == 0) {
 				counts->tmp_files++;
 				counts->tmp_bytes += (long long)st.st_size;
 			}
@@ -132,7 +160,7 @@ int file_sweep_startup(const char *state, struct store *store, struct sweep_coun
 				counts->job_dirs++;
 			counts->job_bytes += bytes;
 		} else if (exists > 0) {
-			sweep_tmp(dirfd(files), e->d_name, counts);
+			sweep_tmp(dirfd(files), e->d_name, id, store, counts);
 		}
 	}
 	closedir(files);

@@ -10,10 +10,13 @@ struct store;
 struct sweep_counts {
 	long long tmp_files, tmp_bytes;        /* ".tmp-*" files of interrupted uploads removed */
 	long long job_dirs, job_bytes;         /* directories of jobs no longer in the database removed */
+	long long kept_restored, kept_dropped; /* old versions of unfinished replacements put back, removed */
 };
 
-/* At start-up, before any request: removes every ".tmp-*" file in STATE/files/<job>/<attempt>/
- * and the directory of every job that store does not hold. Walks exactly those two levels and
+/* At start-up, before any request: removes every ".tmp-*" file in STATE/files/<job>/<attempt>/,
+ * settles every old version kept there by an unfinished replacement (file_replace.h: put back
+ * when its row still names it, else removed), and removes the directory of every job that store
+ * does not hold. Walks exactly those two levels and
  * follows no symbolic link. Returns 0, or -1 with errno when STATE/files cannot be read (a
  * missing one is 0: nothing was ever uploaded); what could not be removed is skipped. */
 int file_sweep_startup(const char *state, struct store *store, struct sweep_counts *counts);

@@ -6,8 +6,9 @@
  * (".tmp-<name>-<random>") in that directory while its SHA-256 is computed; at the end the digest
  * is compared with X-Checksum-Sha256 (a mismatch discards the file: 400 checksum_mismatch), the
  * file is fsynced, and the writer thread renames it into place and commits its index row in one
- * write, only if the attempt still holds the lease (store_file_commit). A file without an index
- * row is never served. Names are checked before anything touches the disk (api_file_name).
+ * write, only if the attempt still holds the lease (store_file_commit; the order that keeps the
+ * row and the disk in agreement when that write fails is file_replace.c's). A file without an
+ * index row is never served. Names are checked before anything touches the disk (api_file_name).
  *
  * probes.json, frames.json and metrics.json are the files whose content the server checks:
  * probes.json and frames.json are served as the answers of GET /v1/jobs/{id}/probes and

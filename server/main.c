@@ -330,9 +330,11 @@ static void sweep_files(struct server *srv)
 		log_say(LOG_PRIO_WARNING, "cannot sweep '%s/files': %s", srv->cfg.state, strerror(errno));
 		return;
 	}
-	log_say(LOG_PRIO_INFO, "start-up sweep of '%s/files': removed temporary upload files: %lld (%lld bytes); "
-		"directories of deleted jobs: %lld (%lld bytes)", srv->cfg.state, n.tmp_files, n.tmp_bytes, n.job_dirs,
-		n.job_bytes);
+	log_say(LOG_PRIO_INFO,
+		"start-up sweep of '%s/files': removed temporary upload files: %lld (%lld bytes); "
+		"directories of deleted jobs: %lld (%lld bytes); old versions of unfinished replacements put back: %lld, "
+		"removed: %lld",
+		srv->cfg.state, n.tmp_files, n.tmp_bytes, n.job_dirs, n.job_bytes, n.kept_restored, n.kept_dropped);
 }
 
 static int serve(struct server *srv)

@@ -23,6 +23,7 @@
 
 struct write_op {
 	write_fn fn;
+	after_fn after; /* NULL, or run once the batch's COMMIT has returned */
 	void *arg;
 	struct api_error *err;
 	enum api_code status;
@@ -140,6 +141,17 @@ static double seconds_since(const struct timespec *t0)
 	return (double)(t1.tv_sec - t0->tv_sec) + 1e-9 * (double)(t1.tv_nsec - t0->tv_nsec);
 }
 
+/* The after functions of a batch, last op first: undoing in reverse order puts back what each op
+ * found, when two ops of one batch changed the same thing (two versions of one file). */
+static void run_after(struct write_op *op)
+{
+	if (!op)
+		return;
+	run_after(op->next);
+	if (op->after)
+		op->after(op->arg, op->status == API_OK);
+}
+
 static void run_batch(struct store *s, struct write_op *batch)
 {
 	struct conn *c = &s->writer;
@@ -175,6 +187,7 @@ static void run_batch(struct store *s, struct write_op *batch)
 				op->status = api_fail(op->err, e.code, "", "%s", e.message);
 	}
 	store_events_flush(s, committed);
+	run_after(batch);
 	if (s->observe_commit)
 		s->observe_commit(s->observe_cls, seconds_since(&t0));
 }
@@ -219,7 +232,12 @@ static void *writer_main(void *arg)
 
 enum api_code store_write(struct store *s, write_fn fn, void *arg, struct api_error *err)
 {
-	struct write_op op = { .fn = fn, .arg = arg, .err = err, .status = API_INTERNAL };
+	return store_write_then(s, fn, NULL, arg, err);
+}
+
+enum api_code store_write_then(struct store *s, write_fn fn, after_fn after, void *arg, struct api_error *err)
+{
+	struct write_op op = { .fn = fn, .after = after, .arg = arg, .err = err, .status = API_INTERNAL };
 	pthread_mutex_lock(&s->lock);
 	if (s->stopping) {
 		pthread_mutex_unlock(&s->lock);

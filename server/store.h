@@ -217,6 +217,8 @@ enum api_code store_lease_check(struct store *s, const struct principal *who, lo
 				int *current_attempt, struct api_error *err);
 /* Renames tmp_path to final_path and indexes the file, in one write, only if (id, attempt) still
  * holds the lease; the rename happens in the writer so a stale attempt can never replace a file.
+ * When the write fails, before or at its COMMIT, the file at final_path is the one the index
+ * still describes (the old version is kept until the new row is durable, file_replace.h).
  * The file's size counts towards its job's and owner's stored bytes (a new version of the same
  * name and attempt replaces the old one's size). */
 enum api_code store_file_commit(struct store *s, const struct principal *who, long long id, int attempt,

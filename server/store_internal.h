@@ -57,6 +57,12 @@ typedef enum api_code (*write_fn)(struct store *s, struct conn *c, void *arg, st
 
 /* Runs fn(arg) in the writer's group transaction and returns after COMMIT (or the error). */
 enum api_code store_write(struct store *s, write_fn fn, void *arg, struct api_error *err);
+/* After the batch's COMMIT has returned, on the writer thread and before the next batch:
+ * committed is 1 when fn's changes are durable, 0 when they were rolled back (fn failed, or the
+ * COMMIT did). For what fn did outside the database and must undo or finish. */
+typedef void (*after_fn)(void *arg, int committed);
+/* store_write, then after(arg, committed) (see after_fn) before returning. */
+enum api_code store_write_then(struct store *s, write_fn fn, after_fn after, void *arg, struct api_error *err);
 /* Asks for wake-ups after the current batch commits (writer thread only). */
 void store_after_commit(struct store *s, unsigned wake);
 

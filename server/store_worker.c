@@ -13,15 +13,13 @@
  * job_transition(), so the choice costs one index probe per user with queued jobs.
  */
 #include "store_internal.h"
+#include "file_replace.h"
 
 #include <errno.h>
-#include <fcntl.h>
-#include <libgen.h>
 #include <limits.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <unistd.h>
 
 /* ---- fencing ---- */
 
@@ -571,20 +569,12 @@ struct file_op {
 	long long id, size;
 	int attempt;
 	const char *name, *sha256, *tmp_path, *final_path;
+	struct file_replace replace;
 };
 
-static int fsync_dir_of(const char *path)
-{
-	char copy[SERVER_PATH_MAX + 256];
-	snprintf(copy, sizeof copy, "%s", path);
-	int fd = open(dirname(copy), O_RDONLY | O_DIRECTORY);
-	if (fd < 0)
-		return -1;
-	int rc = fsync(fd);
-	close(fd);
-	return rc;
-}
-
+/* The order (file_replace.c): the row is written first, the file moved in place last, so nothing
+ * in this write can fail after the disk changed; file_done then keeps or undoes that change by
+ * whether the COMMIT made the row durable. */
 static enum api_code file_run(struct store *s, struct conn *c, void *arg, struct api_error *err)
 {
 	struct file_op *op = arg;
@@ -592,13 +582,19 @@ static enum api_code file_run(struct store *s, struct conn *c, void *arg, struct
 	if (rc != API_OK)
 		return rc;
 	/* a new version of the same name and attempt replaces the old file: only the difference counts */
-	sqlite3_stmt *st = conn_stmt(c, "SELECT size FROM files WHERE job_id = ?1 AND name = ?2 AND attempt = ?3");
+	sqlite3_stmt *st = conn_stmt(c,
+				     "SELECT size, sha256 FROM files WHERE job_id = ?1 AND name = ?2 AND attempt = ?3");
 	if (!st)
 		return db_fail(c, err, "reading the file index");
 	sqlite3_bind_int64(st, 1, op->id);
 	sqlite3_bind_text(st, 2, op->name, -1, SQLITE_STATIC);
 	sqlite3_bind_int(st, 3, op->attempt);
-	long long replaced = sqlite3_step(st) == SQLITE_ROW ? sqlite3_column_int64(st, 0) : 0;
+	long long replaced = 0;
+	char old_sha256[65] = "";
+	if (sqlite3_step(st) == SQLITE_ROW) {
+		replaced = sqlite3_column_int64(st, 0);
+		snprintf(old_sha256, sizeof old_sha256, "%s", col_text(st, 1));
+	}
 	sqlite3_reset(st);
 	if ((rc = stored_bytes_add(c, op->id, op->size - replaced, err)) != API_OK)
 		return rc;
@@ -614,9 +610,15 @@ static enum api_code file_run(struct store *s, struct conn *c, void *arg, struct
 	sqlite3_bind_int64(st, 6, now_ms());
 	if ((rc = step_done(c, st, err, "indexing a file")) != API_OK)
 		return rc;
-	if (rename(op->tmp_path, op->final_path) != 0 || fsync_dir_of(op->final_path) != 0)
+	if (file_replace_begin(&op->replace, op->tmp_path, op->final_path, old_sha256[0] ? old_sha256 : NULL) != 0)
 		return api_fail(err, api_storage_code(errno), "", "cannot store file '%s': %s", op->name, strerror(errno));
 	return API_OK;
+}
+
+static void file_done(void *arg, int committed)
+{
+	struct file_op *op = arg;
+	file_replace_end(&op->replace, committed);
 }
 
 enum api_code store_file_commit(struct store *s, const struct principal *who, long long id, int attempt,
@@ -625,7 +627,7 @@ enum api_code store_file_commit(struct store *s, const struct principal *who, lo
 {
 	struct file_op op = { .who = who, .id = id, .size = size, .attempt = attempt, .name = name,
 			      .sha256 = sha256, .tmp_path = tmp_path, .final_path = final_path };
-	return store_write(s, file_run, &op, err);
+	return store_write_then(s, file_run, file_done, &op, err);
 }
 
 enum api_code store_file_find(struct store *s, long long id, const char *name, int max_attempt, int *attempt,

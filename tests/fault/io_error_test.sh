@@ -21,14 +21,8 @@ cd "$(dirname "$0")/../.."
 svc_init "$build"
 fault_init "$build" || exit 1
 
-control="$SVC_TMP/faults"
-: > "$control"
-mkdir -p "$SVC_TMP/main"
-SVC_WRAP=(env LD_PRELOAD="$FAULT_SHIM" PORO_FAULT_ROOT="$SVC_TMP/main" PORO_FAULT_CONTROL="$control")
-svc_start main --lease-seconds 60 --min-free-mb 0
-check server_starts_under_shim $? "no server"
-SVC_WRAP=()
-fault_client_init main
+fault_start main --lease-seconds 60 --min-free-mb 0
+control=$FAULT_CONTROL
 
 # fault RULE NAME CODE STATUS: a submission under RULE is refused as CODE/STATUS, health degrades,
 # and the server recovers when the rule is lifted.

@@ -60,7 +60,7 @@ tiny_submission() {
 #   - every key acknowledged (200 or 201) is present exactly once, as the job id the client got;
 #   - no job is in two states: its state is the to_state of its last event, it has one
 #     creation event, and each event starts from the state the one before it left;
-#   - every indexed file is on disk at its indexed size, in files/JOB/ATTEMPT/;
+#   - every indexed file is on disk at its indexed size and SHA-256, in files/JOB/ATTEMPT/;
 #   - no stale result: a succeeded job's files of its final attempt include result.h5, and no
 #     file or log chunk belongs to an attempt after the job's last.
 # Prints one PASS or FAIL line per property, named NAME_...
@@ -70,7 +70,7 @@ check_store() {
 	[ "$out" = ok ]
 	check "${name}_integrity_check" $? "$out"
 	python3 - "$state" "$record" "$name" <<'PY'
-import os, sqlite3, sys
+import hashlib, os, sqlite3, sys
 state, record, name = sys.argv[1:4]
 db = sqlite3.connect("file:%s/poro.db?mode=ro" % state, uri=True)
 def report(prop, problems):
@@ -119,12 +119,14 @@ for j, (st, attempt) in jobs.items():
         problems.append("job %d is %s but its last event left it %s" % (j, st, ev[-1][1]))
 report("one_state_per_job", problems)
 problems = []
-for j, attempt, fname, size in db.execute("SELECT job_id, attempt, name, size FROM files"):
+for j, attempt, fname, size, sha in db.execute("SELECT job_id, attempt, name, size, sha256 FROM files"):
     path = os.path.join(state, "files", str(j), str(attempt), fname)
     if not os.path.isfile(path):
         problems.append("job %d attempt %d '%s' is indexed but not on disk" % (j, attempt, fname))
     elif os.path.getsize(path) != size:
         problems.append("job %d attempt %d '%s' has %d bytes, %d indexed" % (j, attempt, fname, os.path.getsize(path), size))
+    elif hashlib.sha256(open(path, "rb").read()).hexdigest() != sha:
+        problems.append("job %d attempt %d '%s' differs from its indexed SHA-256" % (j, attempt, fname))
 report("indexed_files_on_disk", problems)
 problems = []
 for j, (st, attempt) in jobs.items():
@@ -166,6 +168,21 @@ refusal_is() {
 		[ -n "$(svc_header Retry-After)" ] && grep -q "^HTTP/1.1 $2 " "$SVC_HEADERS"
 }
 
+# fault_start NAME [server flags...]: starts instance NAME under the shim with the rule file
+# FAULT_CONTROL (empty: no fault; write a rule into it to inject one), then fault_client_init.
+fault_start() {
+	local name=$1
+	shift
+	FAULT_CONTROL="$SVC_TMP/faults"
+	: > "$FAULT_CONTROL"
+	mkdir -p "$SVC_TMP/$name"
+	SVC_WRAP=(env LD_PRELOAD="$FAULT_SHIM" PORO_FAULT_ROOT="$SVC_TMP/$name" PORO_FAULT_CONTROL="$FAULT_CONTROL")
+	svc_start "$name" "$@"
+	check server_starts_under_shim $? "no server"
+	SVC_WRAP=()
+	fault_client_init "$name"
+}
+
 # fault_client_init NAME: tokens of a user (FAULT_USER) and a worker (FAULT_POOL) on instance
 # NAME, the submission body FAULT_CASE (tiny_column.json), an empty FAULT_RECORD, and three
 # acknowledged submissions before any fault.
@@ -191,12 +208,18 @@ fault_claim() {
 	FAULT_JOB=$(json '["job"]["id"]' < "$SVC_BODY")
 	FAULT_ATTEMPT=$(json '["job"]["attempt"]' < "$SVC_BODY")
 	check worker_claims "$([ "$code" = 200 ] && [ -n "$FAULT_JOB" ]; echo $?)" "status $code"
+	fault_version "$1"
+}
+
+# fault_version BYTES: a new random result.h5 of BYTES for fault_upload (its SHA-256 in FAULT_SUM).
+fault_version() {
 	head -c "$1" /dev/urandom > "$SVC_TMP/result.h5"
 	FAULT_SUM=$(sha256sum < "$SVC_TMP/result.h5" | cut -d' ' -f1)
 }
 
-# fault_upload: uploads that result.h5 for the claimed attempt; prints the status.
+# fault_upload [NAME]: uploads that result.h5 for the claimed attempt as NAME (default result.h5);
+# prints the status.
 fault_upload() {
-	svc_req PUT "/v1/worker/jobs/$FAULT_JOB/files/result.h5?attempt=$FAULT_ATTEMPT" "$FAULT_POOL" \
+	svc_req PUT "/v1/worker/jobs/$FAULT_JOB/files/${1:-result.h5}?attempt=$FAULT_ATTEMPT" "$FAULT_POOL" \
 		-H "X-Checksum-Sha256: $FAULT_SUM" --data-binary "@$SVC_TMP/result.h5"
 }
