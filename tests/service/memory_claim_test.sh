@@ -9,6 +9,8 @@
 #     while it takes a smaller one submitted after it, and a worker with a larger limit takes it;
 #   - poro submit --memory-mb sends it and poro show prints it; a bad value is refused before any
 #     request is made;
+#   - poro-pilot.sbatch gives its worker the allocation's memory (--mem, or --mem-per-cpu times
+#     the CPUs), and poro-slurm-provider refuses a --mem sbatch would not take;
 #   - a database at schema version 5 (before memory_mb) upgrades in place, every job and event
 #     kept, its jobs stating no memory.
 #   bash tests/service/memory_claim_test.sh BUILD_DIR      (from the repository root)
@@ -131,6 +133,27 @@ check big_worker_takes_big_job "$([ "$fat_by" = big:1 ]; echo $?)" "4096 MB job 
 for p in "${workers[@]}"; do kill -TERM "$p" 2>/dev/null; kill -TERM "$p" 2>/dev/null; wait "$p" 2>/dev/null; done
 workers=()
 svc_stop run
+
+# ---- the Slurm pilot's memory and the provider's --mem -----------------------------------------------
+mkdir -p "$tmp/bin"
+printf '#!/bin/sh\necho 1:00:00\n' > "$tmp/bin/squeue"
+printf '#!/bin/sh\necho "$@" > "%s"\n' "$tmp/pilot.args" > "$tmp/bin/worker"
+chmod +x "$tmp/bin/squeue" "$tmp/bin/worker"
+pilot_memory() { # SLURM variables...: the --memory-limit-mb the pilot script gives its worker
+	rm -f "$tmp/pilot.args"
+	env -i PATH="$tmp/bin:/usr/bin:/bin" SLURM_JOB_ID=7 PORO_SERVER=http://127.0.0.1:9 PORO_TOKEN_FILE=/dev/null \
+		PORO_WORKER="$tmp/bin/worker" TMPDIR="$tmp" "$@" bash deploy/slurm/poro-pilot.sbatch 2>> "$tmp/pilot.err"
+	sed -n 's/.*--memory-limit-mb \([0-9]*\).*/\1/p' "$tmp/pilot.args" 2>/dev/null
+}
+per_node=$(pilot_memory SLURM_MEM_PER_NODE=16384 SLURM_CPUS_PER_TASK=8)
+per_cpu=$(pilot_memory SLURM_MEM_PER_CPU=2048 SLURM_CPUS_PER_TASK=4)
+none=$(pilot_memory SLURM_CPUS_PER_TASK=4)
+check pilot_passes_allocation_memory "$([ "$per_node" = 16384 ] && [ "$per_cpu" = 8192 ] && [ "$none" = 0 ]; echo $?)" \
+	"--mem 16384: '$per_node', --mem-per-cpu 2048 x 4: '$per_cpu', none: '$none'; $(tail -2 "$tmp/pilot.err" 2>/dev/null)"
+deploy/slurm/poro-slurm-provider --server http://127.0.0.1:9 --token-file /dev/null --mem 16GB > /dev/null 2> "$tmp/provider.err"
+status=$?
+check provider_refuses_bad_mem "$([ "$status" = 2 ] && grep -q "^poro-slurm-provider: --mem must be a size such as 16G" "$tmp/provider.err"; echo $?)" \
+	"exit $status: $(cat "$tmp/provider.err")"
 
 # ---- a database at schema version 5 upgrades in place ------------------------------------------------
 svc_start old
