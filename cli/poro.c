@@ -1,8 +1,8 @@
 /*
  * poro.c - the user's command line for the job service (docs/service.md §3 "Users"):
  *
- *   poro submit CASE.json [--wait] [--json] [--priority N] [--threads N] [--wall-time S] [--name NAME]
- *                         [--idempotency-key K]
+ *   poro submit CASE.json [--wait] [--json] [--priority N] [--threads N] [--wall-time S] [--memory-mb M]
+ *                         [--name NAME] [--idempotency-key K]
  *   poro wait [--json] ID
  *   poro ls [--state S[,S...]] [--limit N] [--after ID] [--json]
  *   poro show [--json] ID
@@ -32,8 +32,8 @@
 
 static const struct subcommand COMMANDS[] = {
 	{ "submit",
-	  "submit CASE.json [--wait] [--json] [--priority N] [--threads N] [--wall-time S] [--name NAME]\n"
-	  "                   [--idempotency-key K]",
+	  "submit CASE.json [--wait] [--json] [--priority N] [--threads N] [--wall-time S] [--memory-mb M]\n"
+	  "                   [--name NAME] [--idempotency-key K]",
 	  "Submits a case; prints the new job's id on stdout.\n"
 	  "  -w, --wait               follow the job to its end (as poro wait) and exit with its outcome\n"
 	  "  -j, --json               print the job as the API answers, instead of the id (with --wait,\n"
@@ -41,6 +41,8 @@ static const struct subcommand COMMANDS[] = {
 	  "  -p, --priority N         -100..100 (0): order among your own queued jobs, highest first\n"
 	  "  -t, --threads N          1..256 (1): threads the solver may use, up to the server's limit\n"
 	  "      --wall-time S        1..2592000 seconds (86400): the job fails when it runs longer\n"
+	  "      --memory-mb M        0..16777216 MB (0, not stated): only a worker whose solvers may use\n"
+	  "                           at least M MB takes the job (its --memory-limit-mb, a pilot's --mem)\n"
 	  "  -n, --name NAME          a name shown by ls and show\n"
 	  "      --idempotency-key K  a key of yours: the same key and case again give the same job\n"
 	  "An invalid case is refused with every problem as 'JSON-pointer: message' (exit 6).\n",

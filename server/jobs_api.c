@@ -3,9 +3,9 @@
  * probes (the probes.json a worker extracted from result.h5, served as stored).
  *
  * A submission is checked completely before anything is stored: the request keys and ranges
- * (422 naming the key; threads also against --max-job-threads), then the case with the solver's
- * own loader, case_load_json(), on the tree already parsed from the body, so one tree is built,
- * not two. Its "JSON-pointer: message" lines (at most CASE_PROBLEMS_MAX, then a count of the rest)
+ * (422 naming the key; threads also against --max-job-threads; memory_mb 0..JOB_MEMORY_MB_MAX,
+ * 0 being "not stated"), then the case with the solver's own loader, case_load_json(), on the
+ * tree already parsed from the body, so one tree is built, not two. Its "JSON-pointer: message" lines (at most CASE_PROBLEMS_MAX, then a count of the rest)
  * become problems [{"field": "/case<pointer>", "message"}] (422 invalid_case, whose message gives
  * the total). The case is stored in canonical form (json_dumps with JSON_COMPACT |
  * JSON_SORT_KEYS: the loader's c->json), and case_sha256 is the SHA-256 of that text. The
@@ -149,7 +149,7 @@ struct submission {
 	const char *key;                 /* the Idempotency-Key header, or NULL */
 	char *batch;                     /* owned, or NULL (jobs_batch.c) */
 	int exclusive;
-	long long priority, threads, wall;
+	long long priority, threads, wall, memory_mb;
 	char case_sha[DIGEST_HEX_SIZE], body_sha[DIGEST_HEX_SIZE];
 };
 
@@ -167,8 +167,8 @@ static void submission_release(struct submission *s)
  * replying. */
 static int submission_check(struct request *r, struct submission *s)
 {
-	static const char *const keys[] = { "case", "priority", "threads", "wall_time_seconds", "name", "batch",
-					    "exclusive", NULL };
+	static const char *const keys[] = { "case", "priority", "threads", "wall_time_seconds", "memory_mb", "name",
+					    "batch", "exclusive", NULL };
 	json_t *body = api_body_object(r);
 	if (!body)
 		return -1;
@@ -186,6 +186,7 @@ static int submission_check(struct request *r, struct submission *s)
 	if (api_int_member(r, body, "priority", PRIORITY_MIN, PRIORITY_MAX, 0, &s->priority) ||
 	    api_int_member(r, body, "threads", 1, THREADS_MAX, 1, &s->threads) || check_threads(r, s->threads) ||
 	    api_int_member(r, body, "wall_time_seconds", 1, WALL_TIME_MAX, WALL_TIME_DEFAULT, &s->wall) ||
+	    api_int_member(r, body, "memory_mb", 0, JOB_MEMORY_MB_MAX, 0, &s->memory_mb) ||
 	    api_string_member(r, body, "name", SERVER_NAME_MAX, 0, &name) ||
 	    jobs_batch_members(r, body, &s->batch, &s->exclusive) || check_case(r, case_spec, &loaded))
 		goto done;
@@ -229,7 +230,8 @@ void jobs_submit(struct request *r)
 	struct job_submit in = { .who = &r->who, .idempotency_key = s.key, .body_sha256 = s.body_sha,
 				 .case_json = s.canonical, .case_sha256 = s.case_sha, .name = s.name, .case_title = s.title,
 				 .priority = (int)s.priority, .threads = (int)s.threads,
-				 .wall_time_seconds = (int)s.wall, .batch = s.batch, .exclusive = s.exclusive };
+				 .wall_time_seconds = (int)s.wall, .memory_mb = s.memory_mb, .batch = s.batch,
+				 .exclusive = s.exclusive };
 	json_t *job = NULL;
 	int created = 0;
 	struct api_error err = { 0 };

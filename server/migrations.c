@@ -196,6 +196,11 @@ static const char *const MIGRATIONS[] = {
 	"UPDATE jobs SET case_title = json_extract(case_json, '$.title') WHERE json_valid(case_json);"
 	"CREATE INDEX jobs_user_search ON jobs (user_id, id, state, created_at, name, case_title);"
 	"CREATE INDEX jobs_search ON jobs (id, state, created_at, user_id, name, case_title);",
+	/* 6: the memory a job needs, MB (docs/service.md, "Memory"): a claim that states the memory
+	 * its solver may use (max_memory_mb) is given only jobs that fit. 0 is "not stated", what
+	 * every job stored before asked for, so they stay claimable by any worker as before. No
+	 * index: the claim reads it from the rows its indexes already find. */
+	"ALTER TABLE jobs ADD COLUMN memory_mb INTEGER NOT NULL DEFAULT 0;",
 };
 
 #define MIGRATION_COUNT ((int)(sizeof MIGRATIONS / sizeof MIGRATIONS[0]))

@@ -29,6 +29,10 @@
  * particular time, so any pilot may start it and, when its time runs out first, hand it back with
  * a checkpoint for the next to resume (docs/slurm.md). */
 #define JOB_WALL_TIME_DEFAULT 86400
+/* The most memory a job may ask for, MB (16 TiB): more than any node the service runs on has, so
+ * a larger memory_mb is a mistake (a size in bytes or kB given as MB) and is refused at submission
+ * rather than left queued for a worker that never comes. */
+#define JOB_MEMORY_MB_MAX (1LL << 24)
 
 struct server_config {
 	char listen[256];             /* HOST:PORT; port 0 picks a free one */

@@ -76,6 +76,7 @@ struct job_submit {
 	const char *name;             /* or NULL */
 	const char *case_title;       /* the case's "title", or NULL */
 	int priority, threads, wall_time_seconds;
+	long long memory_mb;          /* memory the job needs, MB; 0: not stated */
 	const char *batch;            /* the benchmark run's label, or NULL (jobs_submit.h) */
 	int exclusive;                /* 1: runs alone on its worker */
 };
@@ -166,11 +167,12 @@ struct job_claim {
 	int exclusive_ok;             /* the worker runs nothing now: it may take an exclusive job */
 	long long seconds_left;       /* only jobs whose wall_time_seconds fit this (a pilot's allocation); -1: any */
 	long long max_threads;        /* only jobs asking for at most this many threads; 0: any */
+	long long max_memory_mb;      /* only jobs asking for at most this much memory, MB; 0: any */
 	long long claim_latency_ms;   /* out: submit (or requeue) to claim */
 };
-/* Leases the next job by fair share (docs/service.md §2) among those that fit in->seconds_left
- * and in->max_threads, leaving exclusive jobs to claims with exclusive_ok; *job is NULL when
- * none is claimable. */
+/* Leases the next job by fair share (docs/service.md §2) among those that fit in->seconds_left,
+ * in->max_threads and in->max_memory_mb, leaving exclusive jobs to claims with exclusive_ok;
+ * *job is NULL when none is claimable. */
 enum api_code store_claim(struct store *s, struct job_claim *in, json_t **job, struct api_error *err);
 /* Renews the lease of (id, attempt); progress (object or NULL) and solver_version (or NULL) are
  * recorded. *cancel is 1 when a cancel was requested. */

@@ -106,7 +106,7 @@ json_t *col_json_time(sqlite3_stmt *st, int i);
 #define JOB_COLUMNS "j.id, u.name, j.name, j.state, j.priority, j.threads, j.wall_time_seconds, j.attempt, " \
 	"j.created_at, j.started_at, j.finished_at, j.case_sha256, j.solver_version, j.worker_host, " \
 	"j.progress, j.message, j.cancel_requested, j.user_id, j.not_before, u.running, u.max_running, " \
-	"j.batch, j.exclusive, j.case_title "
+	"j.batch, j.exclusive, j.case_title, j.memory_mb "
 /* The job of a row of JOB_COLUMNS as JSON; s gives what "waiting" needs besides the row (the
  * default cap on running jobs, whether a worker is live). */
 json_t *job_from_row(struct store *s, sqlite3_stmt *st);

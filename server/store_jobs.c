@@ -110,6 +110,7 @@ json_t *job_from_row(struct store *s, sqlite3_stmt *st)
 	json_object_set_new(job, "exclusive", json_boolean(sqlite3_column_int(st, 22)));
 	/* the case's title, kept beside the job for the dashboard's search (store_search.c) */
 	json_object_set_new(job, "case_title", col_json_text(st, 23));
+	json_object_set_new(job, "memory_mb", json_integer(sqlite3_column_int64(st, 24)));
 	return job;
 }
 
@@ -343,8 +344,8 @@ static enum api_code submit_run(struct store *s, struct conn *c, void *arg, stru
 	    (rc = next_job_id(c, &id, err)) != API_OK)
 		return rc;
 	sqlite3_stmt *st = conn_stmt(c, "INSERT INTO jobs (user_id, name, state, priority, threads, wall_time_seconds,"
-					" case_json, case_sha256, created_at, queued_at, id, stored_bytes, batch, exclusive, case_title)"
-					" VALUES (?1, ?2, 'queued', ?3, ?4, ?5, ?6, ?7, ?8, ?8, ?9, ?10, ?11, ?12, ?13)");
+					" case_json, case_sha256, created_at, queued_at, id, stored_bytes, batch, exclusive, case_title,"
+					" memory_mb) VALUES (?1, ?2, 'queued', ?3, ?4, ?5, ?6, ?7, ?8, ?8, ?9, ?10, ?11, ?12, ?13, ?14)");
 	if (!st)
 		return db_fail(c, err, "preparing a job insert");
 	sqlite3_bind_int64(st, 9, id);
@@ -360,6 +361,7 @@ static enum api_code submit_run(struct store *s, struct conn *c, void *arg, stru
 	sqlite3_bind_int(st, 3, in->priority);
 	sqlite3_bind_int(st, 4, in->threads);
 	sqlite3_bind_int(st, 5, in->wall_time_seconds);
+	sqlite3_bind_int64(st, 14, in->memory_mb);
 	sqlite3_bind_text(st, 6, in->case_json, -1, SQLITE_STATIC);
 	sqlite3_bind_text(st, 7, in->case_sha256, -1, SQLITE_STATIC);
 	sqlite3_bind_int64(st, 8, now_ms());

@@ -102,7 +102,9 @@ struct claim_op {
  * only jobs whose wall_time_seconds fit (a pilot whose allocation ends sooner must not start what
  * it cannot finish), and jobs that asked for no wall time (JOB_WALL_TIME_DEFAULT, server.h), which
  * move from pilot to pilot by checkpoints; max_threads > 0 likewise leaves out jobs asking for
- * more threads than the worker has. */
+ * more threads than the worker has, and max_memory_mb > 0 jobs asking for more memory than its
+ * solver may use (such a solver would only fail, out of memory). A job with memory_mb 0 stated
+ * none and fits every claim. */
 static enum api_code pick(struct store *s, struct conn *c, long long now, const struct job_claim *in, long long *id,
 			  struct api_error *err)
 {
@@ -112,7 +114,8 @@ static enum api_code pick(struct store *s, struct conn *c, long long now, const 
 		" AND (coalesce(u.max_running, ?2) = 0 OR u.running < coalesce(u.max_running, ?2))"
 		" AND EXISTS (SELECT 1 FROM jobs j WHERE j.user_id = u.id AND j.state = 'queued' AND j.not_before <= ?1"
 		"             AND (?3 OR j.exclusive = 0)"
-		" AND (?4 < 0 OR j.wall_time_seconds <= ?4 OR j.wall_time_seconds = ?5) AND (?6 = 0 OR j.threads <= ?6))"
+		" AND (?4 < 0 OR j.wall_time_seconds <= ?4 OR j.wall_time_seconds = ?5) AND (?6 = 0 OR j.threads <= ?6)"
+		" AND (?7 = 0 OR j.memory_mb <= ?7))"
 		" ORDER BY u.running, u.last_claim_seq, u.id LIMIT 1");
 	if (!st)
 		return db_fail(c, err, "choosing a user");
@@ -122,6 +125,7 @@ static enum api_code pick(struct store *s, struct conn *c, long long now, const 
 	sqlite3_bind_int64(st, 4, in->seconds_left);
 	sqlite3_bind_int(st, 5, JOB_WALL_TIME_DEFAULT);
 	sqlite3_bind_int64(st, 6, in->max_threads);
+	sqlite3_bind_int64(st, 7, in->max_memory_mb);
 	long long user = 0;
 	if (sqlite3_step(st) == SQLITE_ROW)
 		user = sqlite3_column_int64(st, 0);
@@ -131,6 +135,7 @@ static enum api_code pick(struct store *s, struct conn *c, long long now, const 
 	st = conn_stmt(c, "SELECT id FROM jobs WHERE user_id = ?1 AND state = 'queued' AND not_before <= ?2"
 			  " AND (?3 OR exclusive = 0)"
 			  " AND (?4 < 0 OR wall_time_seconds <= ?4 OR wall_time_seconds = ?5) AND (?6 = 0 OR threads <= ?6)"
+			  " AND (?7 = 0 OR memory_mb <= ?7)"
 			  " ORDER BY priority DESC, id LIMIT 1");
 	if (!st)
 		return db_fail(c, err, "choosing a job");
@@ -140,6 +145,7 @@ static enum api_code pick(struct store *s, struct conn *c, long long now, const 
 	sqlite3_bind_int64(st, 4, in->seconds_left);
 	sqlite3_bind_int(st, 5, JOB_WALL_TIME_DEFAULT);
 	sqlite3_bind_int64(st, 6, in->max_threads);
+	sqlite3_bind_int64(st, 7, in->max_memory_mb);
 	if (sqlite3_step(st) == SQLITE_ROW)
 		*id = sqlite3_column_int64(st, 0);
 	sqlite3_reset(st);
@@ -178,7 +184,7 @@ static enum api_code claim_run(struct store *s, struct conn *c, void *arg, struc
 	sqlite3_stmt *st = conn_stmt(c, "UPDATE jobs SET attempt = attempt + 1, started_at = ?2, lease_expires_at = ?3,"
 					" worker = ?4, worker_host = ?5, lease_user_id = ?6, cancel_requested = 0,"
 					" progress = NULL WHERE id = ?1"
-					" RETURNING attempt, case_json, threads, wall_time_seconds, queued_at, exclusive");
+					" RETURNING attempt, case_json, threads, wall_time_seconds, queued_at, exclusive, memory_mb");
 	if (!st)
 		return db_fail(c, err, "preparing a claim");
 	sqlite3_bind_int64(st, 1, id);
@@ -198,6 +204,7 @@ static enum api_code claim_run(struct store *s, struct conn *c, void *arg, struc
 			    "wall_time_seconds", sqlite3_column_int(st, 3), "lease_seconds", s->cfg->lease_seconds);
 	op->in->claim_latency_ms = now - sqlite3_column_int64(st, 4);
 	json_object_set_new(op->job, "exclusive", json_boolean(sqlite3_column_int(st, 5)));
+	json_object_set_new(op->job, "memory_mb", json_integer(sqlite3_column_int64(st, 6)));
 	sqlite3_step(st); /* a RETURNING statement completes its update on the step that returns DONE */
 	sqlite3_reset(st);
 	json_object_set_new(op->job, "checkpoint", checkpoint_of(c, id, attempt));

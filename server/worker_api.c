@@ -27,6 +27,7 @@
 #define OFFSET_MAX (1LL << 50)
 #define EXIT_CODE_MAX 255
 #define ARTIFACTS_MAX 16   /* files one finish may declare; a worker uploads four */
+#define MEMORY_MB_MAX (1LL << 30) /* a claim's max_memory_mb: the largest poro-worker --memory-limit-mb */
 
 /* Required integer member: 0, or -1 after replying. */
 static int required_int(struct request *r, json_t *body, const char *key, long long min, long long max,
@@ -57,18 +58,19 @@ static void wait_for_work(struct server *srv, unsigned long long seq, long long 
 void worker_claim(struct request *r)
 {
 	static const char *const keys[] = { "worker", "host", "threads", "wait_seconds", "exclusive", "seconds_left",
-					    "max_threads", NULL };
+					    "max_threads", "max_memory_mb", NULL };
 	json_t *body = api_body_object(r);
 	if (!body)
 		return;
 	const char *worker, *host;
-	long long threads, wait, seconds_left, max_threads;
+	long long threads, wait, seconds_left, max_threads, max_memory_mb;
 	if (api_known_keys(r, body, keys) || api_string_member(r, body, "worker", SERVER_NAME_MAX, 1, &worker) ||
 	    api_string_member(r, body, "host", SERVER_NAME_MAX, 0, &host) ||
 	    api_int_member(r, body, "threads", 1, THREADS_MAX, 1, &threads) ||
 	    api_int_member(r, body, "wait_seconds", 0, WAIT_SECONDS_MAX, 0, &wait) ||
 	    api_int_member(r, body, "seconds_left", 0, 1LL << 40, -1, &seconds_left) ||
-	    api_int_member(r, body, "max_threads", 1, THREADS_MAX, 0, &max_threads)) {
+	    api_int_member(r, body, "max_threads", 1, THREADS_MAX, 0, &max_threads) ||
+	    api_int_member(r, body, "max_memory_mb", 1, MEMORY_MB_MAX, 0, &max_memory_mb)) {
 		json_decref(body);
 		return;
 	}
@@ -83,7 +85,7 @@ void worker_claim(struct request *r)
 	struct server *srv = r->srv;
 	struct job_claim in = { .who = &r->who, .worker = worker, .host = host ? host : worker,
 				.exclusive_ok = json_is_true(exclusive), .seconds_left = seconds_left,
-				.max_threads = max_threads };
+				.max_threads = max_threads, .max_memory_mb = max_memory_mb };
 	long long deadline = now_ms() + 1000 * wait;
 	metrics_worker_claim(srv->metrics, worker, r->who.name, in.host, (int)threads, 1);
 	server_worker_seen(srv);

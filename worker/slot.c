@@ -99,7 +99,14 @@ static void claim_end(int claimer, int got_exclusive)
 
 /* The claim: "exclusive" when it may be answered with an exclusive job; with a lifetime it says
  * how many seconds a job may still run here (the server gives only jobs whose wall_time_seconds
- * fit), and with --idle-exit it waits no longer than the idle time left. */
+ * fit), and with --idle-exit it waits no longer than the idle time left.
+ *
+ * With a memory limit it says the memory a job claimed now may use, max_memory_mb (the server
+ * gives only jobs whose memory_mb fit, or that stated none). That is the limit itself: each
+ * solver runs under its own RLIMIT_AS of --memory-limit-mb, whose default already divides the
+ * machine among the slots, so what the other slots run takes nothing from this slot's share, and
+ * a job asking more would only fail, out of memory, here. Sent by every worker with a limit, not
+ * only by pilots: that failure is final wherever it happens. */
 static json_t *claim_body(double now, double idle_since, int exclusive_ok)
 {
 	int wait = WORKER_CLAIM_WAIT;
@@ -117,6 +124,8 @@ static json_t *claim_body(double now, double idle_since, int exclusive_ok)
 		json_object_set_new(body, "seconds_left", json_integer(left));
 		json_object_set_new(body, "max_threads", json_integer(worker_opt.threads));
 	}
+	if (body && worker_opt.memory_limit_mb > 0)
+		json_object_set_new(body, "max_memory_mb", json_integer(worker_opt.memory_limit_mb));
 	return body;
 }
 

@@ -50,7 +50,7 @@ struct worker_options {
 	char work[4096];         /* absolute directory holding job-<id>-<attempt>/ */
 	char solver[4096];       /* absolute path of poro-solve */
 	long memory_limit_mb;    /* RLIMIT_AS of a solver, 0: none (default: WORKER_MEMORY_SHARE of
-				  * physical memory divided by the slots) */
+				  * physical memory divided by the slots); claims state it (slot.c) */
 	long checkpoint_wall;    /* seconds of wall time between checkpoints given to the solver, 0: none */
 	const char *checkpoint_flag; /* the solver's option for it, NULL when the solver has none */
 	double lease_renew;      /* heartbeat interval override, seconds, 0: from the lease */

@@ -20,6 +20,7 @@
 #define PRIORITY_MAX 100
 #define THREADS_MAX 256
 #define WALL_TIME_MAX 2592000
+#define MEMORY_MB_MAX (1LL << 24)   /* the server's JOB_MEMORY_MB_MAX */
 #define LIST_LIMIT_MAX 1000
 #define LIST_LIMIT_DEFAULT 100
 
@@ -29,6 +30,7 @@
 struct submit_options {
 	int wait, json;
 	long long priority, threads, wall;    /* 0 threads or wall: the server's default */
+	long long memory_mb;                  /* 0: not stated */
 	int have_priority;
 	const char *name, *key;
 };
@@ -54,6 +56,8 @@ static json_t *submission(const char *file, const struct submit_options *o, int 
 		json_object_set_new(body, "threads", json_integer(o->threads));
 	if (o->wall)
 		json_object_set_new(body, "wall_time_seconds", json_integer(o->wall));
+	if (o->memory_mb)
+		json_object_set_new(body, "memory_mb", json_integer(o->memory_mb));
 	if (o->name)
 		json_object_set_new(body, "name", json_string(o->name));
 	return body;
@@ -64,7 +68,8 @@ int cmd_submit(const struct subcommand *self, int argc, char **argv)
 	static const struct option opts[] = {
 		{ "wait", no_argument, NULL, 'w' },       { "json", no_argument, NULL, 'j' },
 		{ "priority", required_argument, NULL, 'p' }, { "threads", required_argument, NULL, 't' },
-		{ "wall-time", required_argument, NULL, 'W' }, { "name", required_argument, NULL, 'n' },
+		{ "wall-time", required_argument, NULL, 'W' }, { "memory-mb", required_argument, NULL, 'M' },
+		{ "name", required_argument, NULL, 'n' },
 		{ "idempotency-key", required_argument, NULL, 'k' }, { "help", no_argument, NULL, 'h' },
 		{ NULL, 0, NULL, 0 }
 	};
@@ -86,6 +91,10 @@ int cmd_submit(const struct subcommand *self, int argc, char **argv)
 			break;
 		case 'W':
 			if ((rc = cli_parse_int(self, "--wall-time", optarg, 1, WALL_TIME_MAX, &o.wall)))
+				return rc;
+			break;
+		case 'M':
+			if ((rc = cli_parse_int(self, "--memory-mb", optarg, 0, MEMORY_MB_MAX, &o.memory_mb)))
 				return rc;
 			break;
 		case 'n': o.name = optarg; break;
@@ -182,6 +191,9 @@ static void show_job(const json_t *j)
 	show_field("threads", buf);
 	snprintf(buf, sizeof buf, "%lld s", json_get_int(j, "wall_time_seconds", 0));
 	show_field("wall time", buf);
+	long long memory_mb = json_get_int(j, "memory_mb", 0);
+	snprintf(buf, sizeof buf, "%lld MB", memory_mb);
+	show_field("memory", memory_mb > 0 ? buf : "not stated");
 	snprintf(buf, sizeof buf, "%lld", json_get_int(j, "attempt", 0));
 	show_field("attempt", buf);
 	show_field("created", json_get_str(j, "created_at", NULL));

@@ -158,7 +158,8 @@ export function render(root, { id }) {
     clear(details);
     for (const [k, v] of [['user', job.user], ['label', job.name || '-'], ['state', job.state], ['attempt', job.attempt],
       ['worker host', job.worker_host || '-'], ['priority', job.priority], ['threads', job.threads],
-      ['wall time limit', fmtDuration(job.wall_time_seconds)], ['submitted', fmtTime(job.created_at)],
+      ['wall time limit', fmtDuration(job.wall_time_seconds)],
+      ['memory', job.memory_mb ? `${job.memory_mb} MB` : 'not stated'], ['submitted', fmtTime(job.created_at)],
       ['started', fmtTime(job.started_at)], ['finished', fmtTime(job.finished_at)], ['run time', fmtDuration(elapsed)],
       ['solver', job.solver_version || '-'], ['stored', job.stored_bytes !== undefined ? fmtBytes(job.stored_bytes) : '-']])
       details.append(h('dt', {}, k), h('dd', { dataset: { key: k } }, String(v)));
