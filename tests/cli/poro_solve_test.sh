@@ -69,7 +69,7 @@ bad_input dt_above_cfl "/time/dt"
 grep -q "^/time/dt: must be at most 0.000426 s, 1.25 times the soil skeleton's CFL step h / c_p = 0.00034 s" "$tmp/err"
 check validate_names_the_stable_dt $? "stderr: $(head -c 300 "$tmp/err")"
 
-# ---- limits of a case (docs/case-spec.md "Limits"): the issue's 1.6e9 cells and end time of 1e12 s ----
+# ---- limits of a case (docs/case-spec.md "Limits"): 1.6e9 cells and an end time of 1e12 s, as reported ----
 
 derive too_many_cells 'c["grid"]["extent"] = [1000.0, 1000.0]'
 derive endless 'c["time"]["end"] = 1e12; c["output"]["frame_interval"] = 0'

@@ -2,7 +2,7 @@
 # validation_test.sh - what a submission's validation costs and refuses, against a real poro-server:
 # a case of 1000 bad probes is answered 422 with at most CASE_PROBLEMS_MAX (100) problems and the
 # total stated; threads above --max-job-threads is 422 naming /threads and the limit; cases over a
-# limit of docs/case-spec.md "Limits" (the 1.6e9 cells, an end time of 1e12 s, 40,000
+# limit of docs/case-spec.md "Limits" (a reported 1.6e9 cells, an end time of 1e12 s, 40,000
 # probes) are 422 naming the limit; a case of 10,000 probes (the limit) is accepted; a valid case's
 # warnings (a friction angle that reads as radians) come back with its 201, and a case without one
 # gets an empty list. The server's

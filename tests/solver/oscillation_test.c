@@ -3,7 +3,7 @@
  * known: a point-level checkerboard, a checkerboard of whole cells (constant inside each cell, as
  * cell-wise averaging leaves p'), and a smooth field, on a 6 x 5 cell grid seeded 2x2 per cell
  * with high-entropy values; and the two-cell pattern index on the water pressure of the
- * Mohr-Coulomb slope of 000 §5.3 (k = 1e-3 m/s) as the issue that asked for it read it along
+ * Mohr-Coulomb slope of 000 §5.3 (k = 1e-3 m/s) as the report that asked for it read it along
  * y = 2 m at t = 3 s: 142, 212, 209, 137, 140, 210, 206, 135 kPa from one point column to the
  * next, a pair of high point columns either side of one node, a pair of low ones either side of
  * the next (docs/numerics.md, "A pressure pattern of period two cells").
@@ -112,7 +112,7 @@ static void check_slope_pattern(void)
 	const double want_lo = SLOPE_EXCESS_MIN / sqrt(2.0) / hi, want_hi = SLOPE_EXCESS_MAX / sqrt(2.0) / lo;
 	CHECK(!st && pattern >= want_lo && pattern <= want_hi, "slope_pattern_of_two_cells_flagged",
 	      "status %d, index %.4f, want [%.4f, %.4f]", st, pattern, want_lo, want_hi);
-	/* what the issue found: the indices at the points and at the cells miss it */
+	/* what the report found: the indices at the points and at the cells miss it */
 	CHECK(!st && point < 0.1 * pattern && cell < 0.1 * pattern, "slope_pattern_missed_by_point_and_cell_indices",
 	      "point %.4f, cell %.4f against pattern %.4f", point, cell, pattern);
 

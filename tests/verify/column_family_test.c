@@ -63,7 +63,7 @@ struct member {
 
 static const struct member members[] = {
 	{ 28, 0.00, 1.0e7, 0.0, 1.0e-3, 0, 0 },
-	{ 40, 0.25, 1.0e7, 0.0, 1.0e-3, 0, 1 }, /* the columns: top 0.99375 and 0.9875 m */
+	{ 40, 0.25, 1.0e7, 0.0, 1.0e-3, 0, 1 }, /* the reported columns: top 0.99375 and 0.9875 m */
 	{ 40, 0.50, 1.0e7, 0.0, 1.0e-3, 0, 0 },
 	{ 28, 0.50, 3.0e6, 0.3, 1.0e-3, 0, 1 },
 	{ 28, 0.75, 3.0e7, 0.0, 5.0e-4, 0, 0 },

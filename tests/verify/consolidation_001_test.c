@@ -7,7 +7,7 @@
  *     100 times the explicit scheme's critical step for the same column (stable_dt.h): at Tv =
  *     0.05, 0.1, 0.2, 0.5 and 1 the RMS of (p - p_Terzaghi) / q within 2% and the top row's
  *     settlement within 2% of the closed form (terzaghi_column.h): a step chosen by accuracy,
- *     not stability (issue item 5).
+ *     not stability.
  *     make test samples the 10x run to Tv = 0.2, make verify (PORO_VERIFY_LONG=1) to 1.
  *  b. The same soil by the semi-implicit scheme (tests/cases/terzaghi_single_point.json, its own
  *     grid and dt): the base and mid-height probes within 2% of q of the implicit 10x run's at

@@ -23,7 +23,7 @@
  *
  * And the water pressure's pattern of period two cells (docs/numerics.md, "A pressure pattern of
  * period two cells"): the two-cell pattern index (oscillation.h) of the water points seeded in
- * the foundation below y = FOUNDATION_TOP, at case time PATTERN_TIME, where the issue read it
+ * the foundation below y = FOUNDATION_TOP, at case time PATTERN_TIME, where the report read it
  * (142, 212, 209, 137 ... kPa along y = 2 m). The slope's soil above is left out: where the slide
  * has sheared the seeding lattice, neighbours on it are no longer neighbours and the index reads
  * that as a pattern too. On the cases as they stand the pattern is there (a known failure: the
@@ -60,7 +60,7 @@ static const double snapshot_paper_time[SNAPSHOTS] = {2.0, 4.0, 6.0};   /* 000 F
 #define BAND_SAMPLES 41
 #define BAND_PAPER_TIME 3.0         /* s */
 #define BAND_PRINT_EVERY 5          /* samples between two printed on the INFO line */
-#define PATTERN_TIME 3.0            /* s, case time (the issue's t = 3 s; the paper's 2 s) */
+#define PATTERN_TIME 3.0            /* s, case time (the report's t = 3 s; the paper's 2 s) */
 #define FOUNDATION_TOP 4.0          /* m: the water points seeded below it (the toe plain is at 5 m) */
 #define PATTERN_FLAG 0.1            /* pattern index that flags a pattern: about 7% of the pressure
 				       alternating along one direction (2 A / P / sqrt(2)); measured at
@@ -273,7 +273,7 @@ static void check_slope(double h, int ppc, const char *size)
 	report("k=1e-7 double point modified F-bar", h, ppc, &low);
 	report("k=1e-3 double point standard F-bar", h, ppc, &fbar);
 
-	/* the issue's pattern of period two cells in the water pressure (docs/numerics.md) */
+	/* the reported pattern of period two cells in the water pressure (docs/numerics.md) */
 	const double stabilised = stabilised_pattern(CASE_DIR "mc_slope_k1e-3_double_point.json", h, ppc);
 	printf("INFO mc slope h=%.2f m %dx%d: pressure pattern index of the water seeded below y = %.0f m at t = %.0f s, "
 	       "k=1e-3 %.3f, k=1e-7 %.3f; k=1e-3 with the pressure stabilisation %.3f\n", h, ppc, ppc, FOUNDATION_TOP,
