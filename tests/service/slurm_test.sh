@@ -158,6 +158,8 @@ ids=()
 for i in $(seq 20); do ids+=("$(submit short)"); done
 check twenty_jobs_queued_with_no_worker "$([ "$(sql "SELECT count(*) FROM jobs WHERE state = 'queued'")" = 20 ]; echo $?)" \
 	"$(sql "SELECT state, count(*) FROM jobs GROUP BY state")"
+# an AddressSanitizer build reserves terabytes of address space: its pilots run without the limit
+svc_asan "$build/poro-solve" && export PORO_MEMORY_LIMIT_MB=0
 OMP_NUM_THREADS=1 "$root/deploy/slurm/poro-slurm-provider" --server "$SVC_URL" --token-file "$tmp/worker.token" \
 	--max-pilots 3 --time 1 --cpus 1 --mem 900M --idle-exit 6 --retire-margin 45 --interval 1 --checkpoint-wall 2 \
 	--output-dir "$tmp/pilots" --worker "$root/$build/poro-worker" > "$tmp/provider.log" 2>&1 &
