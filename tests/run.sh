@@ -25,15 +25,19 @@ log="$build/test-output.txt"
 # (tests/solver/thread_count_test.c) and two threads save only 10-25% of a run
 # (docs/performance.md, "Threads"), so two programs side by side nearly halve the time. The
 # longest go first (by their times in the last run, BUILD_DIR/test-times.txt, else the
-# verification programs first) so the short ones fill the other cores around them. The
-# command-line and service tests then run one at a time: they start servers and workers whose
-# deadlines assume the cores are theirs.
+# verification programs first) so the short ones fill the other cores around them; the
+# command-line tests (poro-solve and the tools, no server) join them. The install, browser, fault
+# and service tests then run one at a time: they start servers and workers whose deadlines assume
+# the cores are theirs.
 parallel=() serial=()
 if [ "$mode" = test ]; then
 	for t in "$build"/tests/verify/*_test "$build"/tests/solver/*_test "$build"/tests/common/*_test; do
 		[ -x "$t" ] && parallel+=("$t")
 	done
-	for t in tests/cli/*_test.sh tests/install/*_test.sh tests/web/*_test.sh; do [ -f "$t" ] && serial+=("bash $t $build"); done
+	# the command-line tests run poro-solve and the tools on small cases, no server: beside the
+	# C programs; what starts servers and workers runs alone below
+	for t in tests/cli/*_test.sh; do [ -f "$t" ] && parallel+=("bash $t $build"); done
+	for t in tests/install/*_test.sh tests/web/*_test.sh; do [ -f "$t" ] && serial+=("bash $t $build"); done
 	# fault injection, power loss and the short soak (docs/hardening.md)
 	for t in tests/fault/*_test.sh; do [ -f "$t" ] && serial+=("bash $t $build"); done
 elif [ "$mode" = service ]; then
@@ -61,7 +65,7 @@ jobs=${PORO_TEST_JOBS:-$(nproc 2>/dev/null || echo 1)}
 times="$build/test-times.txt"   # "seconds program" per line, from the last run
 if [ -s "$times" ] && [ "${#parallel[@]}" -gt 1 ]; then
 	mapfile -t parallel < <(for t in "${parallel[@]}"; do
-		printf '%s %s\n' "$(awk -v p="$t" '$2 == p { s = $1 } END { print s + 0 }' "$times")" "$t"
+		printf '%s %s\n' "$(awk -v p="$t" '{ n = $0; sub(/^[^ ]+ /, "", n) } n == p { s = $1 } END { print s + 0 }' "$times")" "$t"
 	done | sort -s -k1,1nr | cut -d' ' -f2-)
 fi
 scratch="$build/.tests"
