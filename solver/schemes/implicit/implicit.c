@@ -380,9 +380,10 @@ static enum poro_status newton(struct sim *s)
 	}
 	return poro_error_set(&s->err, PORO_ESOLVER, "step %ld (t = %.6g s): the Newton iteration did not converge in "
 			      "%d iterations: the energy |delta . r| of the last is %.3g of the first's (tolerance %g), "
-			      "the largest residual %.3g N/m; a smaller dt, or tangent \"consistent\", may converge",
+			      "the largest residual %.3g N/m; a smaller dt%s may converge",
 			      s->step + 1, s->time + s->dt, e->iterations, first > 0.0 ? energy / first : energy,
-			      form->newton_tolerance, largest(e, e->residual, 0x1f));
+			      form->newton_tolerance, largest(e, e->residual, 0x1f),
+			      full_newton ? "" : ", or tangent \"consistent\",");
 }
 
 /* Step 9: the points from the converged increments (001 Eq. 11). */
