@@ -105,6 +105,22 @@ struct claim_op {
  * more threads than the worker has, and max_memory_mb > 0 jobs asking for more memory than its
  * solver may use (such a solver would only fail, out of memory). A job with memory_mb 0 stated
  * none and fits every claim. */
+/* The claim's fit of a queued job j, parameters ?3-?7 (bind_fit), the same in both of pick's
+ * statements so that the user chosen always has a job the second finds. */
+#define JOB_FITS_CLAIM \
+	" AND (?3 OR j.exclusive = 0)" \
+	" AND (?4 < 0 OR j.wall_time_seconds <= ?4 OR j.wall_time_seconds = ?5) AND (?6 = 0 OR j.threads <= ?6)" \
+	" AND (?7 = 0 OR j.memory_mb <= ?7)"
+
+static void bind_fit(sqlite3_stmt *st, const struct job_claim *in)
+{
+	sqlite3_bind_int(st, 3, in->exclusive_ok);
+	sqlite3_bind_int64(st, 4, in->seconds_left);
+	sqlite3_bind_int(st, 5, JOB_WALL_TIME_DEFAULT);
+	sqlite3_bind_int64(st, 6, in->max_threads);
+	sqlite3_bind_int64(st, 7, in->max_memory_mb);
+}
+
 static enum api_code pick(struct store *s, struct conn *c, long long now, const struct job_claim *in, long long *id,
 			  struct api_error *err)
 {
@@ -113,39 +129,27 @@ static enum api_code pick(struct store *s, struct conn *c, long long now, const 
 		"SELECT u.id FROM users u WHERE u.queued > 0"
 		" AND (coalesce(u.max_running, ?2) = 0 OR u.running < coalesce(u.max_running, ?2))"
 		" AND EXISTS (SELECT 1 FROM jobs j WHERE j.user_id = u.id AND j.state = 'queued' AND j.not_before <= ?1"
-		"             AND (?3 OR j.exclusive = 0)"
-		" AND (?4 < 0 OR j.wall_time_seconds <= ?4 OR j.wall_time_seconds = ?5) AND (?6 = 0 OR j.threads <= ?6)"
-		" AND (?7 = 0 OR j.memory_mb <= ?7))"
+		JOB_FITS_CLAIM ")"
 		" ORDER BY u.running, u.last_claim_seq, u.id LIMIT 1");
 	if (!st)
 		return db_fail(c, err, "choosing a user");
 	sqlite3_bind_int64(st, 1, now);
 	sqlite3_bind_int(st, 2, s->cfg->user_max_running);
-	sqlite3_bind_int(st, 3, in->exclusive_ok);
-	sqlite3_bind_int64(st, 4, in->seconds_left);
-	sqlite3_bind_int(st, 5, JOB_WALL_TIME_DEFAULT);
-	sqlite3_bind_int64(st, 6, in->max_threads);
-	sqlite3_bind_int64(st, 7, in->max_memory_mb);
+	bind_fit(st, in);
 	long long user = 0;
 	if (sqlite3_step(st) == SQLITE_ROW)
 		user = sqlite3_column_int64(st, 0);
 	sqlite3_reset(st);
 	if (!user)
 		return API_OK;
-	st = conn_stmt(c, "SELECT id FROM jobs WHERE user_id = ?1 AND state = 'queued' AND not_before <= ?2"
-			  " AND (?3 OR exclusive = 0)"
-			  " AND (?4 < 0 OR wall_time_seconds <= ?4 OR wall_time_seconds = ?5) AND (?6 = 0 OR threads <= ?6)"
-			  " AND (?7 = 0 OR memory_mb <= ?7)"
-			  " ORDER BY priority DESC, id LIMIT 1");
+	st = conn_stmt(c, "SELECT j.id FROM jobs j WHERE j.user_id = ?1 AND j.state = 'queued' AND j.not_before <= ?2"
+			  JOB_FITS_CLAIM
+			  " ORDER BY j.priority DESC, j.id LIMIT 1");
 	if (!st)
 		return db_fail(c, err, "choosing a job");
 	sqlite3_bind_int64(st, 1, user);
 	sqlite3_bind_int64(st, 2, now);
-	sqlite3_bind_int(st, 3, in->exclusive_ok);
-	sqlite3_bind_int64(st, 4, in->seconds_left);
-	sqlite3_bind_int(st, 5, JOB_WALL_TIME_DEFAULT);
-	sqlite3_bind_int64(st, 6, in->max_threads);
-	sqlite3_bind_int64(st, 7, in->max_memory_mb);
+	bind_fit(st, in);
 	if (sqlite3_step(st) == SQLITE_ROW)
 		*id = sqlite3_column_int64(st, 0);
 	sqlite3_reset(st);
