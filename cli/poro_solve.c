@@ -398,6 +398,13 @@ static int cmd_run(const char *path, const struct run_options *opt)
 	}
 	sim_set_checkpoint_wall(s, opt->checkpoint_wall);
 	sim_set_slowdown(s, slowdown);
+	if (c->metrics & (1u << FIGURE_REFERENCE_KERNEL_US | 1u << FIGURE_RELATIVE_STEP_COST) &&
+	    (st = sim_set_reference_timing(s, 1))) {
+		int code = fail(st, sim_error(s), path);
+		sim_destroy(&s);
+		case_destroy(&c);
+		return code;
+	}
 	printf("case '%s': %ld soil points, %ld water points, %ld steps\n", c->title,
 	       (long)sim_soil(s)->n, sim_is_double_point(s) ? (long)sim_water(s)->n : 0L, sim_steps_total(s));
 	if (c->time.dt_auto)

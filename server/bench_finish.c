@@ -164,10 +164,13 @@ static void judge_history(struct request *r, const char *suite, const char *figu
 		snprintf(v->detail, sizeof v->detail, "not compared: %.200s", err.message[0] ? err.message : "no memory");
 	}
 	free(history);
-	*stats = json_pack("{s:o, s:o, s:o, s:o, s:i, s:i, s:f, s:f}", "history_median", real_or_null(v->history_median),
-			   "ratio", real_or_null(v->ratio), "p_slower", real_or_null(v->p_slower), "p_faster",
-			   real_or_null(v->p_faster), "history_samples", v->history_samples, "history_runs", runs,
-			   "alpha", rule->alpha, "min_effect", rule->min_effect);
+	*stats = json_pack("{s:o, s:o, s:o, s:o, s:o, s:o, s:o, s:o, s:i, s:i, s:f, s:f}", "history_median",
+			   real_or_null(v->history_median), "history_min", real_or_null(v->history_min), "history_max",
+			   real_or_null(v->history_max), "ratio", real_or_null(v->ratio), "p_slower",
+			   real_or_null(v->p_slower), "p_faster", real_or_null(v->p_faster), "p_exceed_slower",
+			   real_or_null(v->p_exceed_slower), "p_exceed_faster", real_or_null(v->p_exceed_faster),
+			   "history_samples", v->history_samples, "history_runs", runs, "alpha", rule->alpha,
+			   "min_effect", rule->min_effect);
 }
 
 /* One figure row of a case (bench.h, store.h). */

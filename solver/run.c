@@ -33,6 +33,7 @@
 #include "checkpoint.h"
 #include "output.h"
 #include "phases.h"
+#include "reference_kernel.h"
 #include "sim_internal.h"
 
 #define PROBE_SAMPLES_TARGET 20000
@@ -59,6 +60,20 @@ void sim_get_timing(const struct sim *s, struct sim_timing *t)
 	*t = s->timing;
 	t->points = (long)s->soil.n + (s->double_point ? (long)s->water.n : 0);
 	t->median_step_cpu = step_histogram_median(&s->step_cpu);
+	t->median_reference_cpu = step_histogram_median(&s->reference_cpu);
+}
+
+enum poro_status sim_set_reference_timing(struct sim *s, int on)
+{
+	if (!on || s->reference)
+		return PORO_OK;
+	s->reference = reference_kernel_create();
+	if (!s->reference || step_histogram_init(&s->reference_cpu)) {
+		reference_kernel_destroy(s->reference);
+		s->reference = NULL;
+		return poro_error_set(&s->err, PORO_ENOMEM, "cannot allocate the reference kernel");
+	}
+	return PORO_OK;
 }
 
 /* The slowdown knob: step 1 (the shape functions at the present positions, which the step about
@@ -72,7 +87,9 @@ static enum poro_status slow_down(struct sim *s, double previous_step_cpu)
 	return PORO_OK;
 }
 
-/* One step, timed (sim_get_timing), after the slowdown knob's repeats. */
+/* One step, timed (sim_get_timing), after the slowdown knob's repeats; then, when asked, the
+ * reference kernel, timed on its own: the two alternate every step, so both see the same state of
+ * the machine. */
 static enum poro_status timed_step(struct sim *s, double *last_cpu)
 {
 	double c0 = cpu_now(), w0 = wall_now();
@@ -87,6 +104,8 @@ static enum poro_status timed_step(struct sim *s, double *last_cpu)
 	s->timing.cpu_seconds += c2 - c0;
 	s->timing.wall_seconds += wall_now() - w0;
 	s->timing.steps += !st;
+	if (!st && s->reference)
+		step_histogram_add(&s->reference_cpu, reference_kernel_run(s->reference));
 	return st;
 }
 

@@ -26,6 +26,7 @@
 
 #include "shape.h"
 #include "phases.h"
+#include "reference_kernel.h"
 #include "scheme.h"
 #include "step_health.h"
 
@@ -291,6 +292,8 @@ void sim_destroy(struct sim **ps)
 	particles_release(&s->water);
 	particles_release(&s->soil);
 	step_histogram_release(&s->step_cpu);
+	step_histogram_release(&s->reference_cpu);
+	reference_kernel_destroy(s->reference);
 	if (s->scheme)
 		s->scheme->destroy(s);
 	grid_fields_release(&s->f);

@@ -65,6 +65,8 @@ struct sim {
 	struct sim_timing timing;     /* the steps sim_run took in this process (run.c) */
 	struct step_histogram step_cpu; /* their processor times (step_timing.h), allocated by sim_run */
 	double slowdown;              /* test knob of sim_set_slowdown (run.c); 1 = off */
+	struct reference_kernel *reference;  /* timed after each step when asked (run.c), else NULL */
+	struct step_histogram reference_cpu; /* its processor times */
 	struct poro_error err;
 };
 

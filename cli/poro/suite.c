@@ -124,8 +124,10 @@ static void read_figure(struct reader *rd, struct suite_case *c, const char *kin
 	snprintf(p, sizeof p, "%.300s/%.100s", base, kind);
 	int k = figure_parse(kind);
 	if (k < 0) {
-		problem(rd, p, "unknown figure: the solver reports wall_seconds, cpu_seconds, us_per_point_step, "
-			"cpu_us_per_point_step, median_cpu_us_per_point_step, steps, max_displacement, terzaghi_rms, "
+		problem(rd, p,
+			"unknown figure: the solver reports wall_seconds, cpu_seconds, us_per_point_step, "
+			"cpu_us_per_point_step, median_cpu_us_per_point_step, reference_kernel_us, relative_step_cost, "
+			"steps, max_displacement, terzaghi_rms, "
 			"xie_leo_settlement, runout, peak_q, newton_iterations, mohr_coulomb_peak_error (docs/benchmarks.md)");
 		return;
 	}

@@ -34,20 +34,22 @@ enum { FIGURE_SIM = 1, FIGURE_ELEMENT = 2, FIGURE_SIM_ALWAYS = 4, FIGURE_ELEMENT
 #define FIGURE_EVERY_ELEMENT (FIGURE_ELEMENT | FIGURE_ELEMENT_ALWAYS)
 
 /*      kind                            name                      unit  class               where */
-#define FIGURE_MAP(X)                                                                                          \
-	X(FIGURE_WALL_SECONDS,          "wall_seconds",           "s",  FIGURE_TIMING,      FIGURE_EVERY_RUN) \
-	X(FIGURE_CPU_SECONDS,           "cpu_seconds",            "s",  FIGURE_TIMING,      FIGURE_EVERY_RUN) \
-	X(FIGURE_US_PER_POINT_STEP,     "us_per_point_step",      "us", FIGURE_TIMING,      FIGURE_EVERY_SIM) \
-	X(FIGURE_CPU_US_PER_POINT_STEP, "cpu_us_per_point_step",  "us", FIGURE_TIMING,      FIGURE_EVERY_SIM) \
-	X(FIGURE_MEDIAN_STEP_CPU_US,    "median_cpu_us_per_point_step", "us", FIGURE_TIMING, FIGURE_EVERY_SIM) \
-	X(FIGURE_STEPS,                 "steps",                  "1",  FIGURE_COUNT_CLASS, FIGURE_EVERY_RUN) \
-	X(FIGURE_MAX_DISPLACEMENT,      "max_displacement",       "m",  FIGURE_ACCURACY,    FIGURE_EVERY_SIM) \
-	X(FIGURE_TERZAGHI_RMS,          "terzaghi_rms",           "1",  FIGURE_ACCURACY,    FIGURE_SIM) \
-	X(FIGURE_XIE_LEO_SETTLEMENT,    "xie_leo_settlement",     "1",  FIGURE_ACCURACY,    FIGURE_SIM) \
-	X(FIGURE_RUNOUT,                "runout",                 "m",  FIGURE_ACCURACY,    FIGURE_SIM) \
-	X(FIGURE_PEAK_Q,                "peak_q",                 "Pa", FIGURE_ACCURACY,    FIGURE_EVERY_ELEMENT) \
-	X(FIGURE_NEWTON_ITERATIONS,     "newton_iterations",      "1",  FIGURE_COUNT_CLASS, FIGURE_EVERY_ELEMENT | FIGURE_SIM) \
-	X(FIGURE_MOHR_COULOMB_PEAK,     "mohr_coulomb_peak_error", "1", FIGURE_ACCURACY,    FIGURE_ELEMENT)
+#define FIGURE_MAP(X)                                                                                                \
+	X(FIGURE_WALL_SECONDS, "wall_seconds", "s", FIGURE_TIMING, FIGURE_EVERY_RUN)                                 \
+	X(FIGURE_CPU_SECONDS, "cpu_seconds", "s", FIGURE_TIMING, FIGURE_EVERY_RUN)                                   \
+	X(FIGURE_US_PER_POINT_STEP, "us_per_point_step", "us", FIGURE_TIMING, FIGURE_EVERY_SIM)                      \
+	X(FIGURE_CPU_US_PER_POINT_STEP, "cpu_us_per_point_step", "us", FIGURE_TIMING, FIGURE_EVERY_SIM)              \
+	X(FIGURE_MEDIAN_STEP_CPU_US, "median_cpu_us_per_point_step", "us", FIGURE_TIMING, FIGURE_EVERY_SIM)          \
+	X(FIGURE_REFERENCE_KERNEL_US, "reference_kernel_us", "us", FIGURE_TIMING, FIGURE_SIM)                        \
+	X(FIGURE_RELATIVE_STEP_COST, "relative_step_cost", "1", FIGURE_TIMING, FIGURE_SIM)                           \
+	X(FIGURE_STEPS, "steps", "1", FIGURE_COUNT_CLASS, FIGURE_EVERY_RUN)                                          \
+	X(FIGURE_MAX_DISPLACEMENT, "max_displacement", "m", FIGURE_ACCURACY, FIGURE_EVERY_SIM)                       \
+	X(FIGURE_TERZAGHI_RMS, "terzaghi_rms", "1", FIGURE_ACCURACY, FIGURE_SIM)                                     \
+	X(FIGURE_XIE_LEO_SETTLEMENT, "xie_leo_settlement", "1", FIGURE_ACCURACY, FIGURE_SIM)                         \
+	X(FIGURE_RUNOUT, "runout", "m", FIGURE_ACCURACY, FIGURE_SIM)                                                 \
+	X(FIGURE_PEAK_Q, "peak_q", "Pa", FIGURE_ACCURACY, FIGURE_EVERY_ELEMENT)                                      \
+	X(FIGURE_NEWTON_ITERATIONS, "newton_iterations", "1", FIGURE_COUNT_CLASS, FIGURE_EVERY_ELEMENT | FIGURE_SIM) \
+	X(FIGURE_MOHR_COULOMB_PEAK, "mohr_coulomb_peak_error", "1", FIGURE_ACCURACY, FIGURE_ELEMENT)
 
 /* What each figure is, for docs and reports (figures.c holds the sentences):
  *   wall_seconds          wall time of the steps this process took (element: of the driver)
@@ -56,7 +58,16 @@ enum { FIGURE_SIM = 1, FIGURE_ELEMENT = 2, FIGURE_SIM_ALWAYS = 4, FIGURE_ELEMENT
  *   cpu_us_per_point_step processor microseconds per material-point step
  *   median_cpu_us_per_point_step  the median step's processor time over its points, us: what a
  *                         step costs on warm caches (step_timing.h), the timing figure the
- *                         nightlies judge against history
+ *                         nightlies record
+ *   reference_kernel_us   the median processor time of the reference kernel (reference_kernel.h),
+ *                         timed after each step when this or the next figure is asked for: how
+ *                         fast the machine ran that kind of work during the run
+ *   relative_step_cost    1000 x median_cpu_us_per_point_step / reference_kernel_us: a material-
+ *                         point step's cost in thousandths of the reference kernel, both timed in
+ *                         the same process step by step, so that a machine running slower for a
+ *                         while leaves it nearly unchanged and a slower solver does not: the
+ *                         timing figure the nightlies judge against history (docs/benchmarks.md,
+ *                         "A machine with two speeds")
  *   steps                 steps taken (element: axial increments)
  *   max_displacement      largest displacement |x - x0| of a soil point at the end, m
  *   terzaghi_rms          RMS over the pressure points of (p - p_Terzaghi) / q at the end, each

@@ -22,9 +22,9 @@ cli_setup "${1:-build}"
 export OMP_NUM_THREADS=1 OMP_WAIT_POLICY=passive
 PY3=/usr/bin/python3   # Debian's, where python3-h5py and python3-jsonschema install
 
-# a Terzaghi column of 500 steps asked for its Terzaghi error
+# a Terzaghi column of 500 steps asked for its Terzaghi error and its step in reference-kernel units
 derive_case column tests/cases/terzaghi.json \
-	'c["time"]["end"] = 0.05; c["output"]["frame_interval"] = 0.025; c["metrics"] = {"terzaghi_rms": True}'
+	'c["time"]["end"] = 0.05; c["output"]["frame_interval"] = 0.025; c["metrics"] = {"terzaghi_rms": True, "relative_step_cost": True}'
 run_derived column run_column_with_metrics
 "$PY3" - "$tmp/column" schemas/metrics.schema.json <<'PY' > "$tmp/py" 2>&1
 import json, math, sys, h5py, jsonschema
@@ -39,6 +39,10 @@ for k in ("wall_seconds", "cpu_seconds", "us_per_point_step", "cpu_us_per_point_
 assert f["steps"]["value"] == 500, f["steps"]
 assert 0 < f["terzaghi_rms"]["value"] < 0.02, f["terzaghi_rms"]
 assert f["cpu_us_per_point_step"]["class"] == "timing" and f["terzaghi_rms"]["class"] == "accuracy"
+# the reference kernel was timed beside the steps, and the relative cost is the ratio it says
+ref, rel, med = (f[k]["value"] for k in ("reference_kernel_us", "relative_step_cost", "median_cpu_us_per_point_step"))
+assert ref > 0 and f["reference_kernel_us"]["unit"] == "us" and f["relative_step_cost"]["unit"] == "1", f
+assert abs(rel / (1000 * med / ref) - 1) < 1e-12, (rel, med, ref)
 for k in ("cpu_model", "cores", "memory_mb", "kernel", "compiler", "blas", "host"):
     assert m["machine"][k] not in (None, "", 0), "machine " + k
 with h5py.File(d + "/result.h5", "r") as h:
@@ -66,8 +70,9 @@ grep -q "test knob PORO_DEBUG_SLOWDOWN=1.5" "$tmp/slow.out"
 check slowdown_knob_says_so $? "$(head -3 "$tmp/slow.out")"
 python3 - "$tmp/column/metrics.json" "$tmp/slow/metrics.json" <<'PY'
 import json, sys
-a, b = (json.load(open(p))["figures"]["cpu_us_per_point_step"]["value"] for p in sys.argv[1:])
-print("INFO slowdown knob 1.5: cpu_us_per_point_step %.4g -> %.4g (x%.2f, printed, not asserted)" % (a, b, b / a))
+for k in ("cpu_us_per_point_step", "reference_kernel_us", "relative_step_cost"):
+    a, b = (json.load(open(p))["figures"][k]["value"] for p in sys.argv[1:])
+    print("INFO slowdown knob 1.5: %s %.4g -> %.4g (x%.2f, printed, not asserted)" % (k, a, b, b / a))
 PY
 PORO_DEBUG_SLOWDOWN=0.5 "$solve" run "$tmp/column.json" --out "$tmp/bad" > /dev/null 2> "$tmp/err"
 rc=$?
