@@ -220,7 +220,8 @@ static void small_deformation(int long_run)
 	CHECK(falls, "strip_footing_001_limit_load_falls_with_h", "q_lim/c %.4f, %.4f, %.4f, %.4f at h = 0.5, 0.25, 0.1, "
 	      "0.05 m (0: not reached)", bbar.q_limit, fine[0].q_limit, fine[1].q_limit, fine[2].q_limit);
 	/* h = 0.1 m: 5.447, +5.9% (known: the limits fall as 5.949, 5.587, 5.447 with h = 0.5, 0.25,
-	 * 0.1 m, beyond 3% and spec-001's +5% at h = 0.1 m; docs/numerics.md); h = 0.05 m not yet run */
+	 * 0.1 m, beyond 3% and spec-001's +5% at h = 0.1 m; docs/numerics.md); h = 0.05 m, about 7 h
+	 * on one thread, not yet run (docs/numerics.md) */
 	static const int known[3] = {0, 1, 0};
 	for (int k = 1; k < 3; k++) {
 		char name[96];
