@@ -110,8 +110,11 @@ poro() { # CA_FILE ARGS...: the poro CLI in the worker's namespace, against the 
 }
 id=$(poro "$pki/lab-ca.pem" submit "$tmp/short.json" 2> "$tmp/submit.err")
 check cli_submits_over_tls "$([[ "$id" =~ ^[0-9]+$ ]]; echo $?)" "poro submit: '$id' $(cat "$tmp/submit.err")"
-in_worker "$build/poro-worker" --server "$tls_url" --token-file "$tmp/worker.token" --ca-file "$pki/lab-ca.pem" \
-	--work "$tmp/work" --name remote:1 --threads 1 > "$tmp/worker.log" 2>&1 &
+# not through in_worker: a backgrounded function is a subshell, and its pid is not the worker's, so
+# the TERM below would stop the subshell and leave the worker running (ip netns exec execs the
+# command in its own process)
+ip netns exec "$ns_worker" "$build/poro-worker" --server "$tls_url" --token-file "$tmp/worker.token" \
+	--ca-file "$pki/lab-ca.pem" --work "$tmp/work" --name remote:1 --threads 1 > "$tmp/worker.log" 2>&1 &
 pids+=($!)
 poro "$pki/lab-ca.pem" wait "$id" > /dev/null 2> "$tmp/wait.err"
 status=$?
@@ -119,6 +122,8 @@ check job_runs_on_the_remote_worker "$status" "poro wait exit $status: $(tail -3
 grep -q "route=/v1/worker/claim status=200 .*client=$worker_ip" "$tmp/main.err"
 check claim_came_across_the_network $? "no claim from $worker_ip in the server's log"
 kill -TERM "${pids[-1]}"; wait "${pids[-1]}"
+pgrep -f -- "--name remote:1 " > /dev/null
+check remote_worker_stops_on_term $(( $? == 0 )) "a poro-worker named remote:1 still runs: $(pgrep -fa -- "--name remote:1 ")"
 
 # ---- refusals ---------------------------------------------------------------------------------
 in_worker timeout 30 "$build/poro-worker" --server "$tls_url" --token-file "$tmp/worker.token" --ca-file "$pki/other-ca.pem" \
