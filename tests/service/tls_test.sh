@@ -122,8 +122,8 @@ check job_runs_on_the_remote_worker "$status" "poro wait exit $status: $(tail -3
 grep -q "route=/v1/worker/claim status=200 .*client=$worker_ip" "$tmp/main.err"
 check claim_came_across_the_network $? "no claim from $worker_ip in the server's log"
 kill -TERM "${pids[-1]}"; wait "${pids[-1]}"
-pgrep -f -- "--name remote:1 " > /dev/null
-check remote_worker_stops_on_term $(( $? == 0 )) "a poro-worker named remote:1 still runs: $(pgrep -fa -- "--name remote:1 ")"
+pgrep -f -- "--work $tmp/work " > /dev/null   # this run's worker, by its own work directory
+check remote_worker_stops_on_term $(( $? == 0 )) "the worker still runs: $(pgrep -fa -- "--work $tmp/work ")"
 
 # ---- refusals ---------------------------------------------------------------------------------
 in_worker timeout 30 "$build/poro-worker" --server "$tls_url" --token-file "$tmp/worker.token" --ca-file "$pki/other-ca.pem" \
