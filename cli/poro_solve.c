@@ -398,8 +398,7 @@ static int cmd_run(const char *path, const struct run_options *opt)
 	}
 	sim_set_checkpoint_wall(s, opt->checkpoint_wall);
 	sim_set_slowdown(s, slowdown);
-	if (c->metrics & (1u << FIGURE_REFERENCE_KERNEL_US | 1u << FIGURE_RELATIVE_STEP_COST) &&
-	    (st = sim_set_reference_timing(s, 1))) {
+	if (c->metrics & FIGURES_NEEDING_REFERENCE && (st = sim_time_reference(s))) {
 		int code = fail(st, sim_error(s), path);
 		sim_destroy(&s);
 		case_destroy(&c);

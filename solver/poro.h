@@ -126,7 +126,7 @@ struct sim_timing {
 	double wall_seconds, cpu_seconds;
 	double median_step_cpu;          /* s: the median step's processor time (step_timing.h) */
 	double median_reference_cpu;     /* s: the reference kernel's median processor time, timed after
-					  * each step when sim_set_reference_timing asked; NAN otherwise */
+					  * each step when sim_time_reference asked; NAN otherwise */
 	long steps;
 	long points;
 };
@@ -139,11 +139,11 @@ void sim_get_timing(const struct sim *s, struct sim_timing *t);
  * as much and every result stays bit-identical. 1 (the default) is off. */
 void sim_set_slowdown(struct sim *s, double factor);
 
-/* With on = 1, sim_run times the reference kernel (reference_kernel.h) after each step, outside
+/* From now on sim_run times the reference kernel (reference_kernel.h) after each step, outside
  * the step's own timing, for the figures reference_kernel_us and relative_step_cost: the steps'
  * cost in units of what the machine gives at that moment (docs/benchmarks.md, "A machine with two
- * speeds"). About 45 us a step on the machine of docs/benchmarks.md; off by default. 0, or
+ * speeds"). About 45 us a step on the machine of docs/benchmarks.md; off until asked. 0, or
  * PORO_ENOMEM. */
-enum poro_status sim_set_reference_timing(struct sim *s, int on);
+enum poro_status sim_time_reference(struct sim *s);
 
 #endif

@@ -63,9 +63,9 @@ void sim_get_timing(const struct sim *s, struct sim_timing *t)
 	t->median_reference_cpu = step_histogram_median(&s->reference_cpu);
 }
 
-enum poro_status sim_set_reference_timing(struct sim *s, int on)
+enum poro_status sim_time_reference(struct sim *s)
 {
-	if (!on || s->reference)
+	if (s->reference)
 		return PORO_OK;
 	s->reference = reference_kernel_create();
 	if (!s->reference || step_histogram_init(&s->reference_cpu)) {

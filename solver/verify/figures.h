@@ -91,6 +91,10 @@ enum figure_kind {
 	FIGURE_COUNT
 };
 
+/* The figures a case's "metrics" bits (1u << kind) ask for that need the reference kernel timed
+ * beside the steps (sim_time_reference). */
+#define FIGURES_NEEDING_REFERENCE (1u << FIGURE_REFERENCE_KERNEL_US | 1u << FIGURE_RELATIVE_STEP_COST)
+
 const char *figure_name(enum figure_kind k);
 const char *figure_unit(enum figure_kind k);
 enum figure_class figure_class(enum figure_kind k);

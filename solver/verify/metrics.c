@@ -84,7 +84,7 @@ void metrics_of_run(struct metrics *m, const struct sim *s, const struct case_sp
 	metrics_set(m, FIGURE_US_PER_POINT_STEP, point_steps > 0 ? 1e6 * t.wall_seconds / point_steps : NAN);
 	metrics_set(m, FIGURE_CPU_US_PER_POINT_STEP, point_steps > 0 ? 1e6 * t.cpu_seconds / point_steps : NAN);
 	metrics_set(m, FIGURE_MEDIAN_STEP_CPU_US, t.points > 0 ? 1e6 * t.median_step_cpu / (double)t.points : NAN);
-	if (c->metrics & (1u << FIGURE_REFERENCE_KERNEL_US | 1u << FIGURE_RELATIVE_STEP_COST)) {
+	if (c->metrics & FIGURES_NEEDING_REFERENCE) {
 		metrics_set(m, FIGURE_REFERENCE_KERNEL_US, 1e6 * t.median_reference_cpu);
 		metrics_set(m, FIGURE_RELATIVE_STEP_COST,
 			    t.points > 0 && t.median_reference_cpu > 0
